@@ -1,0 +1,1 @@
+"""Algorithms on plain arrays. Nothing under ``core`` may import ``bpy``."""

@@ -1,0 +1,83 @@
+"""Operations on weight matrices: clean-up, influence limits, mixing.
+
+Every function takes and returns a dense ``(n, b)`` float64 array; none
+modifies its input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import InputError
+
+#: Weights at or below this are treated as no influence (RigNet's threshold).
+INFLUENCE_EPSILON = 1e-4
+
+
+def normalize_rows(weights: np.ndarray) -> np.ndarray:
+    """Clamp negatives and NaN to zero and scale each row to sum to one.
+
+    Rows that are zero everywhere stay zero; callers decide how to fill
+    them (see :func:`empty_rows`).
+    """
+    clean = np.nan_to_num(np.asarray(weights, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    clean = np.maximum(clean, 0.0)
+    sums = clean.sum(axis=1, keepdims=True)
+    return np.divide(clean, sums, out=np.zeros_like(clean), where=sums > 0)
+
+
+def empty_rows(weights: np.ndarray) -> np.ndarray:
+    """(n,) bool: rows with no weight above :data:`INFLUENCE_EPSILON`."""
+    return ~(np.asarray(weights) > INFLUENCE_EPSILON).any(axis=1)
+
+
+def limit_influences(weights: np.ndarray, max_influences: int) -> np.ndarray:
+    """Keep the ``max_influences`` largest weights of each row, renormalised.
+
+    ``max_influences <= 0`` means no limit (rows are still normalised).
+    """
+    weights = normalize_rows(weights)
+    if max_influences <= 0 or max_influences >= weights.shape[1]:
+        return weights
+    drop = np.argpartition(-weights, max_influences - 1, axis=1)[:, max_influences:]
+    limited = weights.copy()
+    np.put_along_axis(limited, drop, 0.0, axis=1)
+    return normalize_rows(limited)
+
+
+def prune_small(weights: np.ndarray, threshold: float = INFLUENCE_EPSILON) -> np.ndarray:
+    """Zero weights at or below ``threshold`` and renormalise, so vertex
+    groups are not cluttered with negligible entries. Rows whose every
+    weight is small keep their largest one."""
+    weights = normalize_rows(weights)
+    keep = weights > threshold
+    rows = np.arange(len(weights))
+    keep[rows, weights.argmax(axis=1)] |= weights.max(axis=1) > 0
+    return normalize_rows(np.where(keep, weights, 0.0))
+
+
+def mix_weights(existing: np.ndarray, incoming: np.ndarray, factor: float, columns: np.ndarray | None = None) -> np.ndarray:
+    """Blend ``incoming`` into ``existing`` by ``factor`` in [0, 1].
+
+    Only ``columns`` (indices, default all) change: those become
+    ``(1 - factor) * existing + factor * incoming``; other columns keep their
+    existing values. Rows are renormalised so the untouched bones keep their
+    share relative to each other.
+    """
+    if existing.shape != incoming.shape:
+        raise ValueError("existing and incoming weights must have the same shape")
+    if not 0.0 <= factor <= 1.0:
+        raise InputError(f"Mix factor must lie in [0, 1], got {factor}.")
+    mixed = np.array(existing, dtype=np.float64, copy=True)
+    cols = np.arange(existing.shape[1]) if columns is None else np.asarray(columns)
+    mixed[:, cols] = (1.0 - factor) * existing[:, cols] + factor * incoming[:, cols]
+    return normalize_rows(mixed)
+
+
+def check_weights(weights: np.ndarray, what: str = "weights") -> None:
+    """Raise :class:`InputError` for NaN/inf or negative entries."""
+    weights = np.asarray(weights)
+    if not np.all(np.isfinite(weights)):
+        raise InputError(f"The {what} contain NaN or infinite values; fix or clean them (Weights > Clean) first.")
+    if np.any(weights < -1e-9):
+        raise InputError(f"The {what} contain negative values; clean them (Weights > Clean) first.")

@@ -1,0 +1,58 @@
+import numpy as np
+import pytest
+
+from autorig_addon.core.closest_point import TriangleMeshQuery, closest_points_on_triangles
+from geometry_fixtures import cylinder, grid
+
+
+def test_closest_point_regions_of_one_triangle():
+    A, B, C = np.array([0.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0.0, 1, 0])
+    P = np.array([
+        [0.2, 0.2, 1.0],    # above the interior
+        [-1.0, -1.0, 0.0],  # beyond vertex A
+        [0.5, -2.0, 0.0],   # beyond edge AB
+        [2.0, 2.0, 0.0],    # beyond edge BC
+        [3.0, -0.5, 0.0],   # beyond vertex B
+    ])
+    n = len(P)
+    points, bary = closest_points_on_triangles(P, np.tile(A, (n, 1)), np.tile(B, (n, 1)), np.tile(C, (n, 1)))
+    expected = np.array([[0.2, 0.2, 0], [0, 0, 0], [0.5, 0, 0], [0.5, 0.5, 0], [1, 0, 0]])
+    np.testing.assert_allclose(points, expected, atol=1e-12)
+    np.testing.assert_allclose(bary.sum(axis=1), 1.0)
+    np.testing.assert_allclose(bary[0], [0.6, 0.2, 0.2], atol=1e-12)
+
+
+def test_surface_point_beats_nearest_vertex_on_coarse_mesh():
+    # Two big triangles: the nearest vertex is far, the surface point is right below.
+    mesh = grid(2, 2, size=10.0)
+    query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
+    result = query.closest(np.array([[5.0, 5.0, 0.3], [2.0, 7.0, -0.1]]))
+    np.testing.assert_allclose(result.distances, [0.3, 0.1], atol=1e-12)
+    np.testing.assert_allclose(result.points, [[5, 5, 0], [2, 7, 0]], atol=1e-12)
+
+
+def test_distances_to_a_cylinder_match_the_radius_gap():
+    mesh = cylinder(radius=0.1, segments=64, capped=False)
+    query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
+    rng = np.random.default_rng(1)
+    angle, z = rng.uniform(0, 2 * np.pi, 200), rng.uniform(0.1, 0.9, 200)
+    P = np.column_stack([0.13 * np.cos(angle), 0.13 * np.sin(angle), z])
+    result = query.closest(P)
+    # Flat facets sit inside the circle by at most r (1 - cos(pi / 64)).
+    assert np.all(result.distances >= 0.03 - 1e-12)
+    assert np.all(result.distances <= 0.03 + 0.1 * (1 - np.cos(np.pi / 64)) + 1e-12)
+    values = mesh.vertices[:, 2]
+    np.testing.assert_allclose(result.interpolate(mesh.triangles, values), z, atol=1e-9)
+
+
+def test_brute_force_agreement_on_random_points():
+    mesh = cylinder(radius=0.2, segments=12, rings=6)
+    query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
+    P = np.random.default_rng(2).uniform(-0.5, 1.5, size=(300, 3))
+    result = query.closest(P)
+    F = mesh.triangles
+    q, m = len(P), len(F)
+    points, _ = closest_points_on_triangles(
+        np.repeat(P, m, axis=0), *(np.tile(mesh.vertices[F[:, k]], (q, 1)) for k in range(3)))
+    brute = np.linalg.norm(points - np.repeat(P, m, axis=0), axis=1).reshape(q, m).min(axis=1)
+    np.testing.assert_allclose(result.distances, brute, atol=1e-12)
