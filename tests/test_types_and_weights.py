@@ -1,0 +1,92 @@
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.types import Mesh, Skeleton, Weights
+from autorig_addon.core.weights import (
+    check_weights,
+    empty_rows,
+    limit_influences,
+    mix_weights,
+    normalize_rows,
+    prune_small,
+)
+
+
+def test_skeleton_default_tails_follow_children_and_extend_leaves():
+    skeleton = Skeleton(joints=[[0, 0, 0], [0, 0, 1], [0, 0, 3]], parents=[-1, 0, 1], names=("a", "b", "c"))
+    np.testing.assert_allclose(skeleton.tails, [[0, 0, 1], [0, 0, 3], [0, 0, 4]])
+    np.testing.assert_allclose(skeleton.bone_lengths, [1, 2, 1])
+
+
+def test_skeleton_rejects_children_before_parents_and_duplicate_names():
+    with pytest.raises(ValueError, match="parents"):
+        Skeleton(joints=np.zeros((2, 3)), parents=[1, -1], names=("a", "b"))
+    with pytest.raises(InputError, match="unique"):
+        Skeleton(joints=np.zeros((2, 3)), parents=[-1, 0], names=("a", "a"))
+
+
+def test_deform_subset_relinks_to_the_nearest_deforming_ancestor():
+    skeleton = Skeleton(joints=np.arange(12.0).reshape(4, 3), parents=[-1, 0, 1, 2], names=("root", "ik", "b", "c"),
+                        deform=[True, False, True, True])
+    subset = skeleton.deform_subset()
+    assert subset.names == ("root", "b", "c")
+    np.testing.assert_array_equal(subset.parents, [-1, 0, 1])
+
+
+def test_mesh_concatenate_shifts_indices_and_records_objects():
+    a = Mesh(np.zeros((3, 3)), [[0, 1, 2]], object_names=("a",))
+    b = Mesh(np.ones((4, 3)), [[0, 1, 2], [1, 2, 3]], object_names=("b",))
+    both = Mesh.concatenate([a, b])
+    np.testing.assert_array_equal(both.triangles, [[0, 1, 2], [3, 4, 5], [4, 5, 6]])
+    assert both.object_names == ("a", "b")
+    assert both.object_slice(1) == slice(3, 7)
+    with pytest.raises(InputError):
+        Mesh(np.zeros((2, 3)), [[0, 1, 2]])
+
+
+def test_weights_select_bones_and_sparse_round_trip():
+    weights = Weights(np.array([[0.2, 0.8], [1.0, 0.0]]), ("a", "b"))
+    picked = weights.select_bones(["b", "missing", "a"])
+    np.testing.assert_array_equal(picked.matrix, [[0.8, 0, 0.2], [0, 0, 1.0]])
+    again = Weights.from_sparse(sp.csr_matrix(weights.matrix), weights.bone_names)
+    np.testing.assert_array_equal(again.matrix, weights.matrix)
+    assert weights.to_sparse().nnz == 3
+
+
+def test_normalize_clamps_nan_and_negative_and_keeps_empty_rows_empty():
+    raw = np.array([[2.0, 2.0, -1.0], [np.nan, 1.0, 3.0], [0.0, 0.0, 0.0]])
+    out = normalize_rows(raw)
+    np.testing.assert_allclose(out, [[0.5, 0.5, 0], [0, 0.25, 0.75], [0, 0, 0]])
+    np.testing.assert_array_equal(empty_rows(out), [False, False, True])
+
+
+def test_limit_influences_keeps_the_largest_and_renormalises():
+    raw = np.array([[0.1, 0.4, 0.3, 0.2], [0.2, 0.3, 0.5, 0.0]])
+    out = limit_influences(raw, 2)
+    np.testing.assert_allclose(out, [[0, 4 / 7, 3 / 7, 0], [0, 3 / 8, 5 / 8, 0]], atol=1e-12)
+    np.testing.assert_allclose(limit_influences(raw, 0), normalize_rows(raw))
+
+
+def test_prune_small_drops_negligible_entries():
+    out = prune_small(np.array([[1.0, 5e-5, 0.0], [0.0, 0.0, 0.0]]))
+    np.testing.assert_allclose(out, [[1, 0, 0], [0, 0, 0]])
+
+
+def test_mix_changes_only_the_chosen_columns():
+    existing = np.array([[0.5, 0.5, 0.0]])
+    incoming = np.array([[0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(mix_weights(existing, incoming, 0.5, [2]), [[1 / 3, 1 / 3, 1 / 3]])
+    np.testing.assert_allclose(mix_weights(existing, incoming, 0.5), [[0.25, 0.25, 0.5]])
+    np.testing.assert_allclose(mix_weights(existing, incoming, 0.0, [2]), existing)
+    with pytest.raises(InputError):
+        mix_weights(existing, incoming, 1.5)
+
+
+def test_check_weights_refuses_nan_and_negative():
+    with pytest.raises(InputError, match="NaN"):
+        check_weights(np.array([[np.nan]]))
+    with pytest.raises(InputError, match="negative"):
+        check_weights(np.array([[-0.5]]))
+    check_weights(np.array([[0.5, 0.5]]))
