@@ -1,0 +1,186 @@
+"""RigNet rig_info text format: known files, round trips, malformed input."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.rignet_format import read_rignet_rig, rignet_rig_text, write_rignet_rig
+from autorig_addon.core.types import Skeleton, Weights
+
+# Hierarchy lines deliberately children-before-parents and joints out of
+# order, as RigNet's exporter does not sort them.
+SMALL_RIG = """\
+joints hand_L 0.6 0.0 1.4
+joints hips 0.0 0.0 1.0
+joints spine 0.0 0.0 1.3
+joints arm_L 0.2 0.0 1.4
+
+joints head 0.0 0.0 1.6
+root hips
+hier arm_L hand_L
+hier spine arm_L
+hier hips spine
+hier spine head
+skin 0 hips 1.0
+skin 1 hips 0.25 spine 0.75
+skin 3 arm_L 0.5 hand_L 0.5
+"""
+
+
+def test_small_file_parents_and_weights():
+    skeleton, weights = read_rignet_rig(SMALL_RIG)
+    # Parents first; among ready joints file order decides (spine before its
+    # children, arm_L (file index 3) before head (file index 4)).
+    assert skeleton.names == ("hips", "spine", "arm_L", "hand_L", "head")
+    parent_names = [skeleton.names[p] if p >= 0 else None for p in skeleton.parents]
+    assert parent_names == [None, "hips", "spine", "arm_L", "spine"]
+    np.testing.assert_allclose(skeleton.joints[skeleton.names.index("hand_L")], [0.6, 0.0, 1.4])
+    np.testing.assert_allclose(skeleton.joints[0], [0.0, 0.0, 1.0])
+    # spine's tail is the mean of its children's heads (arm_L and head).
+    np.testing.assert_allclose(skeleton.tails[1], [0.1, 0.0, 1.5])
+    # The leaf hand_L continues its parent direction at half its length.
+    np.testing.assert_allclose(skeleton.tails[3], [0.8, 0.0, 1.4])
+
+    assert weights.bone_names == skeleton.names
+    assert weights.matrix.shape == (4, 5)
+    expected = np.zeros((4, 5))
+    expected[0, 0] = 1.0
+    expected[1, [0, 1]] = [0.25, 0.75]
+    expected[3, [2, 3]] = [0.5, 0.5]  # vertex 2 has no skin line: zero row
+    np.testing.assert_array_equal(weights.matrix, expected)
+
+
+def test_vertex_count_pads_rows_and_rejects_out_of_range():
+    _, weights = read_rignet_rig(SMALL_RIG, vertex_count=6)
+    assert weights.matrix.shape == (6, 5)
+    assert weights.matrix[4:].sum() == 0.0
+    with pytest.raises(InputError, match=r"Line 14: vertex index 3 is out of range for a mesh of 3"):
+        read_rignet_rig(SMALL_RIG, vertex_count=3)
+
+
+def test_file_without_skin_gives_no_weights(tmp_path):
+    path = tmp_path / "rig.txt"
+    path.write_text("joints a 0 0 0\njoints b 0 0 1\nroot a\nhier a b\n")
+    skeleton, weights = read_rignet_rig(path)
+    assert weights is None
+    assert skeleton.names == ("a", "b")
+    np.testing.assert_array_equal(skeleton.parents, [-1, 0])
+    # Same content through the str path
+    skeleton_again, _ = read_rignet_rig(str(path))
+    np.testing.assert_array_equal(skeleton_again.joints, skeleton.joints)
+
+
+def _random_tree_skeleton(rng, joint_count):
+    parents = np.array([-1] + [int(rng.integers(0, j)) for j in range(1, joint_count)])
+    joints = rng.normal(size=(joint_count, 3))
+    names = tuple(f"bone_{j:02d}.{'L' if j % 2 else 'R'}" for j in range(joint_count))
+    return Skeleton(joints, parents, names)
+
+
+def test_round_trip_write_read_is_exact(tmp_path):
+    rng = np.random.default_rng(7)
+    skeleton = _random_tree_skeleton(rng, 12)
+    matrix = rng.random((30, 12)) * (rng.random((30, 12)) < 0.3)
+    matrix[:, 0] += 0.01  # every vertex keeps one weight, so the row count survives
+    matrix /= matrix.sum(axis=1, keepdims=True)
+    weights = Weights(matrix, skeleton.names)
+
+    path = tmp_path / "rig_info.txt"
+    write_rignet_rig(path, skeleton, weights)
+    skeleton_read, weights_read = read_rignet_rig(path)
+
+    assert skeleton_read.names == skeleton.names
+    np.testing.assert_array_equal(skeleton_read.parents, skeleton.parents)
+    np.testing.assert_array_equal(skeleton_read.joints, skeleton.joints)  # repr floats: bit exact
+    np.testing.assert_array_equal(weights_read.matrix, weights.matrix)
+    assert weights_read.bone_names == skeleton.names
+
+
+def test_round_trip_of_weight_subset_and_empty_rows():
+    rng = np.random.default_rng(3)
+    skeleton = _random_tree_skeleton(rng, 6)
+    subset = (skeleton.names[4], skeleton.names[1])
+    matrix = np.array([[0.3, 0.7], [0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])
+    text = rignet_rig_text(skeleton, Weights(matrix, subset))
+    assert text.count("\nskin ") == 2  # zero rows are not written
+    _, weights_read = read_rignet_rig(text, vertex_count=4)
+    np.testing.assert_array_equal(weights_read.select_bones(subset).matrix, matrix)
+    others = [name for name in skeleton.names if name not in subset]
+    assert weights_read.select_bones(others).matrix.sum() == 0.0
+
+
+def test_reading_unsorted_file_then_writing_gives_sorted_file():
+    skeleton, weights = read_rignet_rig(SMALL_RIG)
+    skeleton_again, weights_again = read_rignet_rig(rignet_rig_text(skeleton, weights), vertex_count=4)
+    assert skeleton_again.names == skeleton.names
+    np.testing.assert_array_equal(skeleton_again.parents, skeleton.parents)
+    np.testing.assert_array_equal(weights_again.matrix, weights.matrix)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("joints a 0 0\nroot a\n", r"Line 1: expected 'joints NAME X Y Z', got 4 fields"),
+        ("joints a 0 0 zero\nroot a\n", r"Line 1: joint coordinate 'zero' is not a number"),
+        ("joints a 0 0 nan\nroot a\n", r"Line 1: joint coordinate 'nan' is not finite"),
+        ("joints a 0 0 0\njoints a 1 0 0\nroot a\n", r"Line 2: joint 'a' is defined twice \(first on line 1\)"),
+        ("joints a 0 0 0\n\nbones a\n", r"Line 3: unknown record 'bones'"),
+        ("joints a 0 0 0\nroot b\n", r"Line 2: root 'b' is not a joint"),
+        ("joints a 0 0 0\nroot a\nhier a c\n", r"Line 3: unknown joint 'c' in 'hier' line"),
+        ("joints a 0 0 0\nroot a\nhier a\n", r"Line 3: expected 'hier PARENT CHILD', got 2 fields"),
+        ("joints a 0 0 0\nroot a\nskin 0 a\n", r"Line 3: expected 'skin VERTEX NAME WEIGHT"),
+        ("joints a 0 0 0\nroot a\nskin 0 a 0.5 a\n", r"Line 3: expected 'skin VERTEX NAME WEIGHT"),
+        ("joints a 0 0 0\nroot a\nskin x a 1\n", r"Line 3: vertex index 'x' is not an integer"),
+        ("joints a 0 0 0\nroot a\nskin -1 a 1\n", r"Line 3: vertex index -1 is negative"),
+        ("joints a 0 0 0\nroot a\nskin 0 a -0.5\n", r"Line 3: negative skin weight -0.5"),
+        ("joints a 0 0 0\nroot a\nskin 0 q 1\n", r"Line 3: unknown joint 'q' in 'skin' line"),
+        ("joints a 0 0 0\nroot a\nskin 0 a 1\nskin 0 a 1\n", r"Vertex 0 has several 'skin' lines \(lines \[3, 4\]\)"),
+        ("root a\n", r"has no 'joints' line; it defines no skeleton"),
+    ],
+)
+def test_malformed_lines_name_the_line(text, message):
+    with pytest.raises(InputError, match=message):
+        read_rignet_rig(text)
+
+
+def test_hierarchy_errors():
+    joints = "joints a 0 0 0\njoints b 0 0 1\njoints c 0 0 2\njoints d 0 0 3\n"
+    with pytest.raises(InputError, match="several roots"):
+        read_rignet_rig(joints + "root a\nroot b\nhier a b\nhier b c\nhier c d\n")
+    with pytest.raises(InputError, match="exactly one root; joints without a parent: a, c"):
+        read_rignet_rig(joints + "root a\nhier a b\nhier c d\n")
+    with pytest.raises(InputError, match="cycle through 'c', 'd'"):
+        read_rignet_rig(joints + "root a\nhier a b\nhier c d\nhier d c\n")
+    with pytest.raises(InputError, match="hierarchy is a cycle"):
+        read_rignet_rig(joints + "hier a b\nhier b c\nhier c d\nhier d a\n")
+    with pytest.raises(InputError, match="Line 5: joint 'a' is its own parent"):
+        read_rignet_rig(joints + "hier a a\n")
+    with pytest.raises(InputError, match=r"Line 7: joint 'c' already has parent 'b' \(line 6\)"):
+        read_rignet_rig(joints + "root a\nhier b c\nhier a c\n")
+    with pytest.raises(InputError, match="Line 5: root 'b' has a parent"):
+        read_rignet_rig(joints + "root b\nhier a b\nhier b c\nhier c d\n")
+
+
+def test_root_is_inferred_without_root_line():
+    skeleton, _ = read_rignet_rig("joints b 0 0 1\njoints a 0 0 0\nhier a b\n")
+    assert skeleton.names == ("a", "b")
+    np.testing.assert_array_equal(skeleton.parents, [-1, 0])
+
+
+def test_missing_file_is_input_error(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        read_rignet_rig(tmp_path / "missing.txt")
+
+
+def test_write_rejects_what_the_format_cannot_hold():
+    two_roots = Skeleton(np.eye(3), [-1, -1, 1], ("a", "b", "c"))
+    with pytest.raises(InputError, match="exactly one root bone, this skeleton has 2 \\(a, b\\)"):
+        rignet_rig_text(two_roots)
+    spaced = Skeleton(np.eye(3)[:2], [-1, 0], ("upper arm", "b"))
+    with pytest.raises(InputError, match="contains whitespace"):
+        rignet_rig_text(spaced)
+    chain = Skeleton(np.eye(3)[:2], [-1, 0], ("a", "b"))
+    with pytest.raises(InputError, match="missing from the skeleton: z"):
+        rignet_rig_text(chain, Weights(np.ones((1, 1)), ("z",)))
+    with pytest.raises(InputError, match="NaN"):
+        rignet_rig_text(chain, Weights(np.array([[np.nan, 1.0]]), ("a", "b")))
