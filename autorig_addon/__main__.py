@@ -1,0 +1,7 @@
+"""``python -m autorig_addon``: the command line (see :mod:`autorig_addon.cli`)."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,43 @@
+"""Blender glue: operators, panels, properties and conversion to core arrays.
+
+Imported only from ``autorig_addon.register`` (or by tests and the command
+line), never from ``core``. Each UI module exposes a ``classes`` tuple,
+registered in :data:`_MODULE_NAMES` order and unregistered in reverse; later
+features add their module name to that list.
+"""
+
+import importlib
+
+import bpy
+
+#: Modules with a ``classes`` tuple, in registration order (property groups
+#: before the operators and panels that use them).
+_MODULE_NAMES = ("properties", "preferences", "operators_transfer", "panels")
+
+
+def _modules():
+    return [importlib.import_module(f".{name}", __name__) for name in _MODULE_NAMES]
+
+
+def _all_classes():
+    return [cls for module in _modules() for cls in module.classes]
+
+
+def register() -> None:
+    """Register every class and ``Scene.autorig``; calling it twice is harmless."""
+    for cls in _all_classes():
+        if not getattr(cls, "is_registered", False):
+            bpy.utils.register_class(cls)
+    from .properties import register_scene_properties
+
+    register_scene_properties()
+
+
+def unregister() -> None:
+    """Undo :func:`register`; calling it when not registered is harmless."""
+    from .properties import unregister_scene_properties
+
+    unregister_scene_properties()
+    for cls in reversed(_all_classes()):
+        if getattr(cls, "is_registered", False):
+            bpy.utils.unregister_class(cls)

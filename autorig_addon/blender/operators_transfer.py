@@ -1,0 +1,573 @@
+"""Weight transfer operators and the plain functions behind them.
+
+The work is split so nothing is written before everything is computed:
+
+1. :func:`plan_transfer` checks the objects and reads the source once,
+2. :func:`compute_transfer` runs the core transfer for every target,
+3. :func:`write_transfer` writes all targets, restoring every one of them
+   if any write fails.
+
+The command line (``autorig_addon.cli``) calls the same three functions.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+from bpy.props import StringProperty
+
+from ..core.errors import Cancelled, InputError
+from ..core.progress import ProgressCallback, report, sub_progress
+from ..core.types import Mesh, Weights
+from ..core.weights import limit_influences, mix_weights, normalize_rows, prune_small
+from . import convert
+from .progress import blender_progress
+from .properties import GROUP_MEMBER_THRESHOLD, TRANSFER_OPTION_NAMES, TransferOptionProperties
+
+#: How a transfer combines with existing vertex groups (see properties.REPLACE_MODE_ITEMS).
+REPLACE_MODES = ("REPLACE", "MIX", "REPLACE_ALL")
+
+
+@dataclass(frozen=True)
+class TransferSettings:
+    """Everything a transfer needs besides the objects.
+
+    Attributes
+    ----------
+    distance_fraction, max_distance, max_normal_angle (degrees),
+    accept_flipped_normals, smoothing_iterations, smoothing_strength,
+    max_influences :
+        as in ``core.transfer.TransferOptions``.
+    mask_group : str, target vertex group forcing inpainting ("" = none)
+    protect_group : str, target vertex group keeping its weights ("" = none)
+    bones : tuple of str or None, bones to transfer (None = every deform bone)
+    replace_mode : one of :data:`REPLACE_MODES`
+    mix_factor : float in [0, 1], used by "MIX"
+    """
+
+    distance_fraction: float = 0.05
+    max_distance: float | None = None
+    max_normal_angle: float = 30.0
+    accept_flipped_normals: bool = True
+    smoothing_iterations: int = 0
+    smoothing_strength: float = 0.5
+    max_influences: int = 0
+    mask_group: str = ""
+    protect_group: str = ""
+    bones: tuple | None = None
+    replace_mode: str = "REPLACE"
+    mix_factor: float = 1.0
+
+    def core_options(self):
+        from ..core.transfer import TransferOptions
+
+        return TransferOptions(
+            distance_fraction=float(self.distance_fraction),
+            max_distance=None if self.max_distance is None else float(self.max_distance),
+            max_normal_angle=float(self.max_normal_angle),
+            accept_flipped_normals=bool(self.accept_flipped_normals),
+            smoothing_iterations=int(self.smoothing_iterations),
+            smoothing_strength=float(self.smoothing_strength),
+            max_influences=int(self.max_influences),
+        )
+
+
+@dataclass
+class TransferPlan:
+    """Checked inputs of a transfer: the objects and the source data.
+
+    Attributes
+    ----------
+    source : bpy.types.Object (mesh)
+    targets : list of bpy.types.Object (meshes)
+    armature : bpy.types.Object (armature deforming the source)
+    bone_names : tuple of b str, the source's deform bones, column order
+    transferred_bones : tuple of str, the subset whose weights are written
+    source_mesh : Mesh
+    source_weights : Weights (n_source, b), rows normalised
+    settings : TransferSettings
+    """
+
+    source: object
+    targets: list
+    armature: object
+    bone_names: tuple
+    transferred_bones: tuple
+    source_mesh: Mesh
+    source_weights: Weights
+    settings: TransferSettings
+
+
+@dataclass
+class TargetOutcome:
+    """Computed result for one target, not yet written.
+
+    Attributes
+    ----------
+    target : bpy.types.Object
+    weights : Weights (n_target, b), the final weights to write
+    status : (n_target,) int8 array of ``VertexStatus``
+    summary : str
+    """
+
+    target: object
+    weights: Weights
+    status: np.ndarray
+    summary: str
+    timings: dict = field(default_factory=dict)
+
+
+# --------------------------------------------------------------------------- object lookup
+
+
+def _object_named(name: str):
+    obj = bpy.data.objects.get(name)
+    if obj is None:
+        meshes = sorted(o.name for o in bpy.data.objects if o.type == "MESH")
+        raise InputError(f"There is no object named '{name}'. Mesh objects here: {', '.join(meshes) or 'none'}.")
+    return obj
+
+
+def split_names(text: str) -> list[str]:
+    """Names from a comma-separated string, blanks dropped."""
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
+def _is_skinned_mesh(obj) -> bool:
+    if obj.type != "MESH" or not len(obj.vertex_groups):
+        return False
+    try:
+        convert.find_armature(obj)
+    except InputError:
+        return False
+    return True
+
+
+def resolve_source(context, name: str):
+    """The source object: ``name`` if given, else the active skinned mesh,
+    else the only skinned mesh among the selected objects."""
+    names = split_names(name)
+    if len(names) > 1:
+        raise InputError(
+            f"Several sources were given ({', '.join(names)}): transfer from one body at a time, "
+            "or join the body meshes into one object first."
+        )
+    if names:
+        source = _object_named(names[0])
+        convert.require_mesh_object(source, "source")
+        return source
+    active = context.view_layer.objects.active
+    selected = list(context.selected_objects)
+    if active is not None and active in selected and _is_skinned_mesh(active):
+        return active
+    candidates = [obj for obj in selected if _is_skinned_mesh(obj)]
+    if len(candidates) > 1:
+        raise InputError(
+            f"Several selected meshes are skinned ({', '.join(sorted(o.name for o in candidates))}): "
+            "make the body the active object or pick it as Source in the AutoRig panel."
+        )
+    if not candidates:
+        raise InputError("No source: pick the skinned body as Source in the AutoRig panel (or make it the active object).")
+    return candidates[0]
+
+
+def resolve_targets(context, names: str, source, extra=None) -> list:
+    """Target objects: the comma-separated ``names``, or when empty the
+    selected meshes other than ``source`` plus ``extra`` (may be None)."""
+    if split_names(names):
+        targets = [_object_named(name) for name in split_names(names)]
+    else:
+        targets = [obj for obj in context.selected_objects if obj.type == "MESH" and obj != source]
+        if extra is not None and extra not in targets and extra != source:
+            targets.append(extra)
+    unique = list(dict.fromkeys(targets))
+    if not unique:
+        raise InputError(
+            "No target: select the meshes to weight together with the source, "
+            "or pick a Target in the AutoRig panel."
+        )
+    return unique
+
+
+# --------------------------------------------------------------------------- plan / compute / write
+
+
+def _check_not_in_edit_mode(obj) -> None:
+    if obj.mode == "EDIT":
+        raise InputError(f"'{obj.name}' is in Edit Mode: switch to Object Mode so its edits are saved, then transfer.")
+
+
+def _transferred_bones(settings: TransferSettings, bone_names: tuple, armature) -> tuple:
+    if settings.bones is None:
+        return bone_names
+    requested = tuple(dict.fromkeys(settings.bones))
+    if not requested:
+        raise InputError(f"No bones chosen: select pose bones of '{armature.name}' or transfer all deform bones.")
+    unknown = [name for name in requested if name not in bone_names]
+    if unknown:
+        raise InputError(
+            f"{', '.join(unknown)}: not deform bones of '{armature.name}'. "
+            f"Deform bones: {', '.join(bone_names[:20])}{' ...' if len(bone_names) > 20 else ''}."
+        )
+    return requested
+
+
+def _check_settings(settings: TransferSettings) -> None:
+    if settings.replace_mode not in REPLACE_MODES:
+        raise InputError(f"Unknown write mode '{settings.replace_mode}': use one of {', '.join(REPLACE_MODES)}.")
+    if not 0.0 <= settings.mix_factor <= 1.0:
+        raise InputError(f"The mix factor must lie between 0 and 1, got {settings.mix_factor}.")
+
+
+def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) -> TransferPlan:
+    """Check the objects and read the source.
+
+    Parameters
+    ----------
+    source : bpy.types.Object, skinned mesh
+    targets : list of bpy.types.Object, meshes to weight
+    settings : TransferSettings
+    depsgraph : bpy.types.Depsgraph
+
+    Raises
+    ------
+    InputError for: a non-mesh source or target, the source among the
+    targets, objects in Edit Mode, a source with no armature or no weights
+    on its deform bones, unknown bones, bad settings.
+    """
+    _check_settings(settings)
+    convert.require_mesh_object(source, "source")
+    _check_not_in_edit_mode(source)
+    for target in targets:
+        convert.require_mesh_object(target, "target")
+        if target == source:
+            raise InputError(f"'{source.name}' is both the source and a target: pick a different mesh to weight.")
+        _check_not_in_edit_mode(target)
+    armature = convert.find_armature(source)
+    bone_names = convert.deform_bone_names(armature)
+    if not bone_names:
+        raise InputError(f"The armature '{armature.name}' has no bones with Deform enabled.")
+    source_weights = convert.read_weights(source, bone_names)
+    if not np.any(source_weights.matrix > 0):
+        raise InputError(
+            f"'{source.name}' has no weights for the deform bones of '{armature.name}': "
+            "its vertex groups must be named after the bones. Skin it first."
+        )
+    source_mesh = convert.read_mesh([source], depsgraph)
+    return TransferPlan(
+        source=source,
+        targets=list(targets),
+        armature=armature,
+        bone_names=bone_names,
+        transferred_bones=_transferred_bones(settings, bone_names, armature),
+        source_mesh=source_mesh,
+        source_weights=Weights(_rows_summing_to_one(source_weights.matrix), bone_names),
+        settings=settings,
+    )
+
+
+def _rows_summing_to_one(matrix: np.ndarray) -> np.ndarray:
+    """(n, b) rows scaled to sum to one, as Blender's Armature modifier
+    normalises them; all-zero rows stay zero. Blender stores weights in
+    [0, 1], so the NaN clean-up of ``normalize_rows`` is not needed here."""
+    sums = matrix.sum(axis=1, keepdims=True)
+    return np.divide(matrix, sums, out=np.zeros_like(matrix), where=sums > 0)
+
+
+def combine_with_existing(existing: np.ndarray, incoming: np.ndarray, columns: np.ndarray, settings: TransferSettings) -> np.ndarray:
+    """Final weights of a target from its existing and transferred weights.
+
+    Parameters
+    ----------
+    existing : (n, b) float64 array, the target's current weights (raw)
+    incoming : (n, b) float64 array, the transferred weights
+    columns : (k,) int array, the transferred bones' columns
+    settings : TransferSettings (replace_mode, mix_factor, max_influences)
+
+    Returns
+    -------
+    (n, b) float64 array: rows sum to one (or are zero where no bone of
+    the written set has weight).
+    """
+    if not needs_existing_weights(settings, len(columns), existing.shape[1]):
+        # The core already normalised, limited and pruned these rows.
+        return incoming
+    factor = settings.mix_factor if settings.replace_mode == "MIX" else 1.0
+    base = np.zeros_like(existing) if settings.replace_mode == "REPLACE_ALL" else existing
+    combined = mix_weights(normalize_rows(base), normalize_rows(incoming), factor, columns)
+    return prune_small(limit_influences(combined, settings.max_influences))
+
+
+def needs_existing_weights(settings: TransferSettings, transferred_count: int, bone_count: int) -> bool:
+    """Whether the target's current weights enter the result (mixing, or a
+    bone subset); a plain replace of every bone ignores them."""
+    return settings.replace_mode == "MIX" or transferred_count != bone_count
+
+
+def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallback | None) -> TargetOutcome:
+    from ..core.transfer import transfer_weights
+
+    settings = plan.settings
+    target_mesh = convert.read_mesh([target], depsgraph)
+    inpaint_mask = convert.vertex_group_mask(target, settings.mask_group, GROUP_MEMBER_THRESHOLD)
+    protected = convert.vertex_group_mask(target, settings.protect_group, GROUP_MEMBER_THRESHOLD)
+    reads_existing = protected is not None or needs_existing_weights(settings, len(plan.transferred_bones), len(plan.bone_names))
+    if reads_existing:
+        existing = convert.read_weights(target, plan.bone_names)
+    else:
+        existing = Weights(np.zeros((len(target.data.vertices), len(plan.bone_names))), plan.bone_names)
+    result = transfer_weights(
+        plan.source_mesh,
+        plan.source_weights,
+        target_mesh,
+        settings.core_options(),
+        inpaint_mask=inpaint_mask,
+        protected=protected,
+        protected_weights=existing if protected is not None else None,
+        progress=progress,
+    )
+    same_order = result.weights.bone_names == plan.bone_names
+    incoming = result.weights.matrix if same_order else result.weights.select_bones(plan.bone_names).matrix
+    column_of = {name: k for k, name in enumerate(plan.bone_names)}
+    columns = np.array([column_of[name] for name in plan.transferred_bones], dtype=np.int64)
+    final = combine_with_existing(existing.matrix, incoming, columns, settings)
+    return TargetOutcome(target, Weights(final, plan.bone_names), np.asarray(result.status), result.summary(), dict(result.timings))
+
+
+def compute_transfer(plan: TransferPlan, depsgraph, progress: ProgressCallback | None = None) -> list[TargetOutcome]:
+    """Run the core transfer for every target of ``plan``; writes nothing."""
+    outcomes = []
+    count = len(plan.targets)
+    for index, target in enumerate(plan.targets):
+        report(progress, index / count, f"Weighting '{target.name}'")
+        outcomes.append(_compute_one(plan, target, depsgraph, sub_progress(progress, index / count, (index + 1) / count)))
+    report(progress, 1.0, "Done")
+    return outcomes
+
+
+def write_transfer(plan: TransferPlan, outcomes: list[TargetOutcome]) -> None:
+    """Write weights, binding and status colours of every outcome.
+
+    All-or-nothing over all targets: if any write fails, every target is
+    restored and the exception re-raised.
+    """
+    snapshots = [convert.ObjectSnapshot.capture(outcome.target) for outcome in outcomes]
+    try:
+        for outcome in outcomes:
+            convert.write_weights(
+                outcome.target, outcome.weights, plan.armature,
+                replace_all=plan.settings.replace_mode == "REPLACE_ALL",
+                keep_groups=[name for name in (plan.settings.mask_group, plan.settings.protect_group) if name],
+            )
+            convert.write_status_attribute(outcome.target, outcome.status)
+    except BaseException:
+        for snapshot in snapshots:
+            snapshot.restore()
+        raise
+
+
+def outcome_report(outcomes: list[TargetOutcome]) -> str:
+    """One line summing up the outcomes, e.g. "Sleeve: 120 copied, 30 inpainted (20%)"."""
+    return "; ".join(f"{outcome.target.name}: {outcome.summary}" for outcome in outcomes)
+
+
+def run_transfer(source, targets: list, settings: TransferSettings, depsgraph, progress: ProgressCallback | None = None) -> list[TargetOutcome]:
+    """Plan, compute and write a transfer; nothing is written on error."""
+    plan = plan_transfer(source, targets, settings, depsgraph)
+    outcomes = compute_transfer(plan, depsgraph, progress)
+    write_transfer(plan, outcomes)
+    return outcomes
+
+
+# --------------------------------------------------------------------------- operators
+
+
+def selected_pose_bone_names(armature) -> tuple:
+    """Names of the armature's selected pose bones (Blender 4.2 to 5.x)."""
+    names = []
+    for pose_bone in armature.pose.bones:
+        # Blender 5 stores bone selection on the pose bone, 4.x on the bone.
+        selected = getattr(pose_bone, "select", None)
+        if selected is None:
+            selected = pose_bone.bone.select
+        if selected:
+            names.append(pose_bone.name)
+    return tuple(names)
+
+
+def scene_defaults(context, is_set) -> dict:
+    """Operator property values taken from the scene settings (``scene.autorig``).
+
+    Parameters
+    ----------
+    context : bpy.types.Context
+    is_set : callable (name) -> bool
+        True for properties the caller set explicitly; those are left out.
+
+    Returns
+    -------
+    dict property name -> value: every transfer option, ``source`` (the
+    panel's Source) and ``targets`` (the selected meshes other than the
+    source, plus the panel's Target), as the panel's Transfer button uses them.
+    """
+    settings = getattr(context.scene, "autorig", None)
+    if settings is None:
+        return {}
+    values = {name: getattr(settings, name) for name in TRANSFER_OPTION_NAMES if not is_set(name)}
+    if not is_set("source") and settings.source is not None:
+        values["source"] = settings.source.name
+    if not is_set("targets"):
+        source_name = values.get("source", "")
+        chosen = [obj for obj in context.selected_objects if obj.type == "MESH" and obj.name != source_name]
+        extra = settings.target
+        if extra is not None and extra not in chosen and extra.name != source_name:
+            chosen.append(extra)
+        values["targets"] = ",".join(obj.name for obj in chosen)
+    return values
+
+
+class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
+    """Copy skin weights from the source body onto the target meshes (garments, accessories), inpainting where they do not match"""
+
+    bl_idname = "autorig.transfer_weights"
+    bl_label = "Transfer Weights"
+    bl_options = {"REGISTER", "UNDO"}
+
+    source: StringProperty(
+        name="Source",
+        description="Name of the skinned mesh to take the weights from (empty: the active skinned mesh)",
+        default="",
+    )
+    targets: StringProperty(
+        name="Targets",
+        description="Comma-separated names of the meshes to weight (empty: the selected meshes except the source)",
+        default="",
+    )
+    bones: StringProperty(
+        name="Bone Names",
+        description="Comma-separated bone names to transfer (empty: as chosen by Bones)",
+        default="",
+    )
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and context.view_layer is not None
+
+    def invoke(self, context, event):
+        for name, value in scene_defaults(context, self.properties.is_property_set).items():
+            setattr(self, name, value)
+        return self.execute(context)
+
+    def _settings(self, armature) -> TransferSettings:
+        if split_names(self.bones):
+            bones = tuple(split_names(self.bones))
+        elif self.bone_subset == "SELECTED":
+            bones = selected_pose_bone_names(armature)
+        else:
+            bones = None
+        return TransferSettings(
+            distance_fraction=self.distance_fraction,
+            max_distance=self.max_distance if self.use_absolute_distance else None,
+            max_normal_angle=math.degrees(self.max_normal_angle),
+            accept_flipped_normals=self.accept_flipped_normals,
+            smoothing_iterations=self.smoothing_iterations,
+            smoothing_strength=self.smoothing_strength,
+            max_influences=self.max_influences,
+            mask_group=self.mask_group,
+            protect_group=self.protect_group,
+            bones=bones,
+            replace_mode=self.replace_mode,
+            mix_factor=self.mix_factor,
+        )
+
+    def execute(self, context):
+        try:
+            source = resolve_source(context, self.source)
+            targets = resolve_targets(context, self.targets, source)
+            depsgraph = context.evaluated_depsgraph_get()
+            settings = self._settings(convert.find_armature(source))
+            with blender_progress(context, "Transfer weights") as progress:
+                outcomes = run_transfer(source, targets, settings, depsgraph, progress)
+        except InputError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        except Cancelled:
+            self.report({"WARNING"}, "Weight transfer cancelled; nothing was changed.")
+            return {"CANCELLED"}
+        self.report({"INFO"}, outcome_report(outcomes))
+        return {"FINISHED"}
+
+
+class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
+    """Create the inpaint-mask vertex group on the target and start Weight Paint: painted vertices are always inpainted instead of copied"""
+
+    bl_idname = "autorig.create_transfer_mask"
+    bl_label = "Paint Inpaint Mask"
+    bl_options = {"REGISTER", "UNDO"}
+
+    group_name: StringProperty(
+        name="Group",
+        description="Name of the mask vertex group (empty: the scene's Inpaint Mask setting)",
+        default="",
+    )
+    target: StringProperty(
+        name="Target",
+        description="Mesh to paint the mask on (empty: the panel's Target, else the active mesh)",
+        default="",
+    )
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and context.view_layer is not None
+
+    def _target(self, context):
+        if self.target:
+            obj = _object_named(self.target)
+        else:
+            settings = getattr(context.scene, "autorig", None)
+            obj = settings.target if settings is not None and settings.target is not None else context.view_layer.objects.active
+        convert.require_mesh_object(obj, "mask target")
+        return obj
+
+    def _group_name(self, context) -> str:
+        if self.group_name.strip():
+            return self.group_name.strip()
+        settings = getattr(context.scene, "autorig", None)
+        name = settings.mask_group.strip() if settings is not None else ""
+        if not name:
+            raise InputError("No mask group name: set Inpaint Mask in the AutoRig panel.")
+        return name
+
+    def execute(self, context):
+        try:
+            obj = self._target(context)
+            name = self._group_name(context)
+            _check_not_in_edit_mode(obj)
+        except InputError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        group = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
+        obj.vertex_groups.active_index = group.index
+        for other in context.selected_objects:
+            if other != obj:
+                other.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        _enter_weight_paint(obj)
+        self.report({"INFO"}, f"Paint '{name}' on '{obj.name}': painted vertices (weight 0.5 or more) will be inpainted.")
+        return {"FINISHED"}
+
+
+def _enter_weight_paint(obj) -> None:
+    """Switch ``obj`` to Weight Paint mode where the context allows (not in
+    some background sessions, where the mode switch is skipped)."""
+    if obj.mode == "WEIGHT_PAINT":
+        return
+    try:
+        bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
+    except RuntimeError:
+        pass
+
+
+classes = (AUTORIG_OT_transfer_weights, AUTORIG_OT_create_transfer_mask)

@@ -1,0 +1,95 @@
+"""Sidebar panels (3D Viewport > N > AutoRig)."""
+
+import bpy
+
+from .operators_transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
+
+#: Sidebar tab the add-on's panels live in.
+SIDEBAR_CATEGORY = "AutoRig"
+
+
+class VIEW3D_PT_autorig(bpy.types.Panel):
+    """Parent panel; Transfer, Skin and Rig panels open beneath it."""
+
+    bl_label = "AutoRig"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = SIDEBAR_CATEGORY
+
+    def draw(self, context):
+        self.layout.label(text="Automatic rigging, skinning and weight transfer", icon="ARMATURE_DATA")
+
+
+def _target_names(context, settings) -> list[str]:
+    """Names of the meshes a transfer would weight, as the operator picks them."""
+    source = settings.source
+    names = [obj.name for obj in context.selected_objects if obj.type == "MESH" and obj != source]
+    if settings.target is not None and settings.target != source and settings.target.name not in names:
+        names.append(settings.target.name)
+    return names
+
+
+class VIEW3D_PT_autorig_transfer(bpy.types.Panel):
+    bl_label = "Weight Transfer"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = SIDEBAR_CATEGORY
+    bl_parent_id = "VIEW3D_PT_autorig"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "autorig", None) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.autorig
+
+        column = layout.column(align=True)
+        column.prop(settings, "source")
+        column.prop(settings, "target")
+        targets = _target_names(context, settings)
+        if targets:
+            shown = ", ".join(targets[:3]) + (f" +{len(targets) - 3}" if len(targets) > 3 else "")
+            column.label(text=f"Targets: {shown}", icon="MESH_DATA")
+        else:
+            column.label(text="Select the meshes to weight", icon="INFO")
+
+        column = layout.column(align=True)
+        column.prop(settings, "use_absolute_distance")
+        if settings.use_absolute_distance:
+            column.prop(settings, "max_distance")
+        else:
+            column.prop(settings, "distance_fraction")
+        column.prop(settings, "max_normal_angle")
+        column.prop(settings, "accept_flipped_normals")
+
+        column = layout.column(align=True)
+        column.prop(settings, "smoothing_iterations")
+        row = column.row()
+        row.active = settings.smoothing_iterations > 0
+        row.prop(settings, "smoothing_strength")
+        column.prop(settings, "max_influences")
+
+        mask_target = settings.target or context.active_object
+        column = layout.column(align=True)
+        if mask_target is not None and mask_target.type == "MESH":
+            column.prop_search(settings, "mask_group", mask_target, "vertex_groups")
+            column.prop_search(settings, "protect_group", mask_target, "vertex_groups")
+        else:
+            column.prop(settings, "mask_group")
+            column.prop(settings, "protect_group")
+        column.operator(AUTORIG_OT_create_transfer_mask.bl_idname, icon="BRUSH_DATA")
+
+        column = layout.column(align=True)
+        column.prop(settings, "bone_subset")
+        column.prop(settings, "replace_mode")
+        row = column.row()
+        row.active = settings.replace_mode == "MIX"
+        row.prop(settings, "mix_factor")
+
+        layout.operator(AUTORIG_OT_transfer_weights.bl_idname, icon="MOD_VERTEX_WEIGHT")
+
+
+classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_transfer)

@@ -1,0 +1,38 @@
+"""Shared pytest fixtures.
+
+Blender-backed fixtures import ``bpy`` lazily, so test modules that only
+exercise ``core`` never load Blender.
+"""
+
+import sys
+from pathlib import Path
+
+import pytest
+
+REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
+TESTS_DIRECTORY = Path(__file__).resolve().parent
+for _path in (str(REPOSITORY_ROOT), str(TESTS_DIRECTORY)):
+    if _path not in sys.path:
+        sys.path.insert(0, _path)
+
+
+@pytest.fixture(scope="session")
+def registered_addon():
+    """The add-on registered once for the whole session (bpy imported here)."""
+    import bpy  # noqa: F401  (loads Blender before the add-on's modules)
+
+    import autorig_addon
+
+    autorig_addon.register()
+    yield autorig_addon
+    autorig_addon.unregister()
+
+
+@pytest.fixture
+def clean_scene(registered_addon):
+    """An empty factory-settings scene, with the add-on registered."""
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    yield bpy.context.scene
+    bpy.ops.wm.read_factory_settings(use_empty=True)
