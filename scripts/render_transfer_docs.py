@@ -45,7 +45,7 @@ POSE = [
     ("upperleg01.R", "X", 30.0),
     ("lowerleg01.R", "X", 35.0),
 ]
-RESOLUTION = (360, 540)
+RESOLUTION = (260, 390)
 
 
 def closest_point_weights(source, source_weights: Weights, target) -> Weights:
