@@ -3,7 +3,8 @@
 Imported only from ``autorig_addon.register`` (or by tests and the command
 line), never from ``core``. Each UI module exposes a ``classes`` tuple,
 registered in :data:`_MODULE_NAMES` order and unregistered in reverse; later
-features add their module name to that list.
+features add their module name to that list. A module may also define
+``register_extras()`` / ``unregister_extras()`` (menu entries and the like).
 """
 
 import importlib
@@ -12,7 +13,7 @@ import bpy
 
 #: Modules with a ``classes`` tuple, in registration order (property groups
 #: before the operators and panels that use them).
-_MODULE_NAMES = ("properties", "preferences", "operators_transfer", "panels")
+_MODULE_NAMES = ("properties", "preferences", "operators_transfer", "operators_rignet", "panels")
 
 
 def _modules():
@@ -31,6 +32,10 @@ def register() -> None:
     from .properties import register_scene_properties
 
     register_scene_properties()
+    for module in _modules():
+        if hasattr(module, "register_extras") and not getattr(module, "_extras_registered", False):
+            module.register_extras()
+            module._extras_registered = True
 
 
 def unregister() -> None:
@@ -38,6 +43,10 @@ def unregister() -> None:
     from .properties import unregister_scene_properties
 
     unregister_scene_properties()
+    for module in reversed(_modules()):
+        if getattr(module, "_extras_registered", False):
+            module.unregister_extras()
+            module._extras_registered = False
     for cls in reversed(_all_classes()):
         if getattr(cls, "is_registered", False):
             bpy.utils.unregister_class(cls)

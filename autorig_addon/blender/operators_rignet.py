@@ -1,0 +1,126 @@
+"""Import and export of RigNet's plain-text rig files (File > Import / Export).
+
+Import builds an armature from the file and, when a mesh with the file's
+vertex count is active, binds it with the file's skin weights. Export writes
+the deform bones of an armature and the weights of a mesh bound to it, in
+world space, so rigs move between this add-on and RigNet's data and scripts.
+"""
+
+from __future__ import annotations
+
+import os
+
+import bpy
+from bpy.props import StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from ..core.errors import InputError
+from ..core.rignet_format import read_rignet_rig, write_rignet_rig
+from . import convert
+from .armature_builder import build_armature
+
+
+def import_rignet_rig(context, filepath: str, mesh_obj=None):
+    """Build the armature of a RigNet file; bind ``mesh_obj`` with its weights.
+
+    Returns the armature object. ``mesh_obj`` (optional) must have the
+    vertex count the file's ``skin`` lines refer to. All-or-nothing: on
+    failure nothing is left in the scene.
+    """
+    vertex_count = len(mesh_obj.data.vertices) if mesh_obj is not None else None
+    skeleton, weights = read_rignet_rig(filepath, vertex_count=vertex_count)
+    name = os.path.splitext(os.path.basename(filepath))[0] or "RigNet"
+    armature = build_armature(skeleton, name, context)
+    if mesh_obj is None or weights is None:
+        return armature
+    try:
+        convert.write_weights(mesh_obj, weights, armature)
+    except BaseException:
+        data = armature.data
+        bpy.data.objects.remove(armature)
+        bpy.data.armatures.remove(data)
+        raise
+    return armature
+
+
+def export_rignet_rig(filepath: str, armature_obj, mesh_obj=None) -> None:
+    """Write the armature's deform bones (and ``mesh_obj``'s weights) to ``filepath``."""
+    skeleton = convert.read_skeleton(armature_obj).deform_subset()
+    if skeleton.bone_count == 0:
+        raise InputError(f"'{armature_obj.name}' has no deform bones to export.")
+    weights = convert.read_weights(mesh_obj, skeleton.names) if mesh_obj is not None else None
+    write_rignet_rig(filepath, skeleton, weights)
+
+
+def _active_mesh(context):
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "MESH" else None
+
+
+class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
+    """Import a RigNet rig file (joints, hierarchy, skin weights) as an armature; the active mesh is bound if its vertex count matches"""
+
+    bl_idname = "autorig.import_rignet"
+    bl_label = "Import RigNet Rig"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".txt"
+    filter_glob: StringProperty(default="*.txt", options={"HIDDEN"})
+
+    def execute(self, context):
+        mesh_obj = _active_mesh(context)
+        try:
+            armature = import_rignet_rig(context, self.filepath, mesh_obj)
+        except (InputError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        bound = f", '{mesh_obj.name}' bound" if mesh_obj is not None and mesh_obj.parent == armature else ""
+        self.report({"INFO"}, f"Imported '{armature.name}' with {len(armature.data.bones)} bones{bound}.")
+        return {"FINISHED"}
+
+
+class AUTORIG_OT_export_rignet(bpy.types.Operator, ExportHelper):
+    """Export the active armature's deform bones, and the weights of the selected mesh bound to it, as a RigNet rig file"""
+
+    bl_idname = "autorig.export_rignet"
+    bl_label = "Export RigNet Rig"
+    bl_options = {"REGISTER"}
+
+    filename_ext = ".txt"
+    filter_glob: StringProperty(default="*.txt", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None and context.active_object.type in {"ARMATURE", "MESH"}
+
+    def execute(self, context):
+        try:
+            mesh_obj = _active_mesh(context)
+            armature = convert.find_armature(mesh_obj) if mesh_obj is not None else context.active_object
+            export_rignet_rig(self.filepath, armature, mesh_obj)
+        except (InputError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Exported '{armature.name}' to {self.filepath}.")
+        return {"FINISHED"}
+
+
+def _menu_import(self, _context):
+    self.layout.operator(AUTORIG_OT_import_rignet.bl_idname, text="RigNet Rig (.txt)")
+
+
+def _menu_export(self, _context):
+    self.layout.operator(AUTORIG_OT_export_rignet.bl_idname, text="RigNet Rig (.txt)")
+
+
+classes = (AUTORIG_OT_import_rignet, AUTORIG_OT_export_rignet)
+
+
+def register_extras() -> None:
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+
+
+def unregister_extras() -> None:
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)

@@ -1,0 +1,86 @@
+import numpy as np
+import pytest
+
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.rignet_format import read_rignet_rig
+from autorig_addon.core.types import Skeleton
+from blender_fixtures import build_rig_scene, group_weights, select_only
+
+
+def test_build_armature_reproduces_skeleton_in_world_space(clean_scene):
+    import bpy
+
+    from autorig_addon.blender.armature_builder import build_armature
+    from autorig_addon.blender.convert import read_skeleton
+
+    skeleton = Skeleton(
+        joints=[[0, 0, 1], [0, 0, 1.5], [0.2, 0, 1.4], [-0.2, 0, 1.4]],
+        parents=[-1, 0, 1, 1], names=("spine", "chest", "arm.L", "arm.R"),
+        deform=[True, True, True, False],
+    )
+    armature = build_armature(skeleton, "Built")
+    again = read_skeleton(armature)
+    assert again.names == skeleton.names
+    np.testing.assert_allclose(again.joints, skeleton.joints, atol=1e-6)
+    np.testing.assert_allclose(again.tails, skeleton.tails, atol=1e-6)
+    np.testing.assert_array_equal(again.parents, skeleton.parents)
+    np.testing.assert_array_equal(again.deform, [True, True, True, False])
+    assert armature.data.bones["chest"].use_connect  # head on the parent's tail
+    assert not armature.data.bones["arm.L"].use_connect
+    assert armature.mode == "OBJECT"
+
+
+def test_zero_length_bone_is_refused_and_nothing_is_left(clean_scene):
+    import bpy
+
+    from autorig_addon.blender.armature_builder import build_armature
+
+    skeleton = Skeleton(joints=[[0, 0, 0], [0, 0, 1]], parents=[-1, 0], names=("a", "b"),
+                        tails=[[0, 0, 1], [0, 0, 1]])
+    before = (len(bpy.data.objects), len(bpy.data.armatures))
+    with pytest.raises(InputError, match="zero length"):
+        build_armature(skeleton, "Broken")
+    assert (len(bpy.data.objects), len(bpy.data.armatures)) == before
+
+
+def test_export_then_import_round_trips_bones_and_weights(clean_scene, tmp_path):
+    import bpy
+
+    scene = build_rig_scene(with_button=False)
+    path = str(tmp_path / "rig.txt")
+    select_only([scene.body], active=scene.body)
+    assert bpy.ops.autorig.export_rignet(filepath=path) == {"FINISHED"}
+    skeleton, weights = read_rignet_rig(path, vertex_count=len(scene.body.data.vertices))
+    deform_names = [b.name for b in scene.armature.data.bones if b.use_deform]
+    assert set(skeleton.names) == set(deform_names)
+    np.testing.assert_allclose(weights.matrix, group_weights(scene.body, skeleton.names), atol=1e-6)
+
+    # Re-import onto a fresh copy of the body without groups.
+    copy = scene.body.copy()
+    copy.data = scene.body.data.copy()
+    copy.vertex_groups.clear()
+    copy.modifiers.clear()
+    copy.parent = None
+    bpy.context.scene.collection.objects.link(copy)
+    select_only([copy], active=copy)
+    assert bpy.ops.autorig.import_rignet(filepath=path) == {"FINISHED"}
+    imported = bpy.data.objects["rig"]
+    assert imported.type == "ARMATURE" and copy.parent == imported
+    np.testing.assert_allclose(group_weights(copy, skeleton.names), weights.matrix, atol=1e-6)
+    assert any(m.type == "ARMATURE" and m.object == imported for m in copy.modifiers)
+
+
+def test_import_with_wrong_vertex_count_leaves_the_scene_unchanged(clean_scene, tmp_path):
+    import bpy
+
+    from blender_fixtures import mesh_object
+
+    path = tmp_path / "rig.txt"
+    path.write_text("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\nskin 5 root 1.0\n")
+    small = mesh_object("Small", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    select_only([small], active=small)
+    before = sorted(o.name for o in bpy.data.objects)
+    with pytest.raises(RuntimeError, match="vertex"):
+        bpy.ops.autorig.import_rignet(filepath=str(path))
+    assert sorted(o.name for o in bpy.data.objects) == before
+    assert len(small.vertex_groups) == 0
