@@ -56,3 +56,12 @@ def test_brute_force_agreement_on_random_points():
         np.repeat(P, m, axis=0), *(np.tile(mesh.vertices[F[:, k]], (q, 1)) for k in range(3)))
     brute = np.linalg.norm(points - np.repeat(P, m, axis=0), axis=1).reshape(q, m).min(axis=1)
     np.testing.assert_allclose(result.distances, brute, atol=1e-12)
+
+
+def test_closest_points_on_a_triangle_cover_every_region():
+    a, b, c = np.array([0.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    points = np.array([[0.2, 0.2, 1.0], [-1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [-0.5, 3.0, 0.0], [0.5, -1.0, 0.0], [-1.0, 0.5, 0.0], [1.0, 1.0, 0.0]])
+    expected = np.array([[0.6, 0.2, 0.2], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]])
+    count = len(points)
+    _, bary = closest_points_on_triangles(points, np.tile(a, (count, 1)), np.tile(b, (count, 1)), np.tile(c, (count, 1)))
+    np.testing.assert_allclose(bary, expected, atol=1e-12)
