@@ -167,3 +167,15 @@ def test_inpainting_reproduces_linear_function_on_a_flat_grid():
     known = (x < 0.15) | (x > 0.85) | (y < 0.15) | (y > 0.85)
     solved = inpaint_weights(Q, known, field)
     np.testing.assert_allclose(solved[~known], field[~known], atol=1e-8)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_huge_and_tiny_scenes_give_the_same_weights(body, scale):
+    source, weights = body
+    target = sleeve(z0=-0.2, height=1.1, rings=41)
+    mask = np.abs(target.vertices[:, 2] - 0.5) < 0.15
+    reference = transfer_weights(source, weights, target, inpaint_mask=mask)
+    scaled = transfer_weights(Mesh(source.vertices * scale, source.triangles), weights,
+                              Mesh(target.vertices * scale, target.triangles), inpaint_mask=mask)
+    np.testing.assert_array_equal(scaled.status, reference.status)
+    np.testing.assert_allclose(scaled.weights.matrix, reference.weights.matrix, atol=1e-7)
