@@ -337,6 +337,80 @@ def _run_transfer(args: argparse.Namespace) -> int:
     return run_batch(args.inputs, args.out, args.format, process, args.summary, args.quiet)
 
 
+# --------------------------------------------------------------------------- skin
+
+
+def _add_skin_arguments(parser: argparse.ArgumentParser) -> None:
+    add_batch_arguments(parser)
+    parser.add_argument("--armature", default="", help="Armature to bind to (default: the only armature in the file)")
+    parser.add_argument("--mesh", action="append", default=[], metavar="OBJ",
+                        help="Mesh to skin (repeat, or comma-separate; default: every mesh except bone shapes)")
+    parser.add_argument("--method", choices=("geometric",), default="geometric",
+                        help="Skinning method (default geometric: falloff of voxel distances)")
+    parser.add_argument("--distance", choices=("geodesic", "hollow"), default="geodesic",
+                        help="geodesic: through the inside of the mesh (RigNet); hollow: HollowDist through empty "
+                             "space, reaches bones outside the body and loose parts (HeterSkinNet)")
+    parser.add_argument("--resolution", type=int, default=88, help="Voxels along the longest side (default 88)")
+    parser.add_argument("--falloff", type=_positive, default=2.0,
+                        help="Exponent of the distance falloff (default 2)")
+    parser.add_argument("--max-influences", type=_non_negative_int, default=4,
+                        help="Bones per vertex to keep, 0 = no limit (default 4)")
+    parser.add_argument("--smoothing-iterations", type=_non_negative_int, default=2,
+                        help="Surface smoothing passes (default 2)")
+    parser.add_argument("--smoothing-strength", type=_fraction, default=0.5,
+                        help="Blend factor of one smoothing pass, 0 to 1 (default 0.5)")
+    parser.add_argument("--replace-all", action="store_true",
+                        help="Remove every existing vertex group first (default: only the deform bones' groups)")
+
+
+def _default_skin_objects(armature_name: str, mesh_names: list[str]):
+    """The armature and meshes a skin run binds, from names or the file's content."""
+    import bpy
+
+    from .blender import scene_io
+    from .blender.operators_transfer import split_names
+    from .core.errors import InputError
+
+    if armature_name:
+        armature = scene_io.find_object(armature_name, "ARMATURE")
+    else:
+        armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+        if len(armatures) != 1:
+            found = ", ".join(obj.name for obj in armatures) or "none"
+            raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
+        armature = armatures[0]
+    names = [name for text in mesh_names for name in split_names(text)]
+    if names:
+        return armature, [scene_io.find_object(name, "MESH") for name in names]
+    shapes = {bone.custom_shape for obj in bpy.data.objects if obj.type == "ARMATURE" for bone in obj.pose.bones}
+    meshes = [obj for obj in bpy.data.objects if obj.type == "MESH" and obj not in shapes]
+    if not meshes:
+        raise InputError("The file holds no mesh to skin.")
+    return armature, meshes
+
+
+def _run_skin(args: argparse.Namespace) -> int:
+    from_args = dict(distance=args.distance, resolution=args.resolution, falloff=args.falloff,
+                     max_influences=args.max_influences, smoothing_iterations=args.smoothing_iterations,
+                     smoothing_strength=args.smoothing_strength, replace_all=args.replace_all)
+
+    def process(input_path, output_path, progress):
+        import bpy
+
+        from .blender import scene_io
+        from .blender.operators_skin import SkinSettings, run_skin
+
+        scene_io.load_scene(input_path)
+        armature, meshes = _default_skin_objects(args.armature, args.mesh)
+        weights = run_skin(armature, meshes, SkinSettings(**from_args), bpy.context.evaluated_depsgraph_get(), progress)
+        progress(1.0, "Saving")
+        scene_io.save_scene(output_path)
+        return {"armature": armature.name, "meshes": [obj.name for obj in meshes],
+                "bones": len(weights.bone_names), "vertices": int(weights.matrix.shape[0])}
+
+    return run_batch(args.inputs, args.out, args.format, process, args.summary, args.quiet)
+
+
 # --------------------------------------------------------------------------- package
 
 
@@ -362,6 +436,12 @@ def _run_package(args: argparse.Namespace) -> int:
 
 register_subcommand("transfer", "Copy skin weights from a body onto garments (robust transfer with inpainting)",
                     _add_transfer_arguments, _run_transfer)
+register_subcommand("skin", "Weight meshes to an armature from voxel distances through the shape",
+                    _add_skin_arguments, _run_skin)
+from . import eval_command  # noqa: E402  (after register_subcommand exists)
+
+register_subcommand("eval", "Score a skinning, rigging or transfer method against artist rigs",
+                    eval_command.add_arguments, eval_command.run)
 register_subcommand("package", "Build the Blender extension .zip packages", _add_package_arguments, _run_package)
 
 

@@ -1,0 +1,657 @@
+"""``python -m autorig_addon eval {skin,rig,transfer} DATA... --method NAME``.
+
+Runs one method on rigged characters whose artist rig is the reference and
+scores it with ``core.skin_metrics`` / ``core.skeleton_metrics``. Prints a
+markdown table per category (one row per character) and a summary (mean and
+median per category and overall); ``--out`` writes the same as JSON::
+
+    {"task": "skin", "method": "boneheat",
+     "characters": [{"name", "category", "path", "l1", ..., "seconds", "unweighted"} |
+                    {"name", "category", "path", "error"}],
+     "summary": {"categories": {CATEGORY: {"count", "failed", "mean": {...}, "median": {...}}},
+                 "overall": {...}}}
+
+The method never sees what it is judged against: a skin method gets the
+mesh and the skeleton (bone heat runs on a copy built from the arrays, with
+no vertex group), a rig method the mesh alone, a transfer method the source
+body with its weights and the target without weights.
+
+Tasks
+-----
+skin
+    ``l1``, ``precision``, ``recall``, ``deform_mean``, ``deform_max``
+    (10 seeded poses, 30 % of the deform bones, N(0, 25 deg); distances in
+    units of the character size) plus ``unweighted``, the vertices the
+    method left without weight. Such a vertex stays where it is under any
+    pose, as in Blender, so the deformation error compares it unmoved with
+    the reference. Vertices the *reference* leaves unweighted are not scored.
+rig
+    ``cd_j2j``, ``cd_j2b``, ``cd_b2b``, ``iou``, ``precision``, ``recall``,
+    ``tree_edit`` on deform bones, joints at the same place merged.
+transfer
+    DATA files without an armature are garments: weights come from the body
+    given by ``--source`` and are scored by edge stretch under the poses
+    (``stretch_p99``, ``stretch_max``). DATA files that are rigged
+    characters are a self-transfer check with an exact reference: the target
+    is the character's own surface pushed out along its normals by
+    :data:`SELF_TRANSFER_OFFSET_FRACTION` of its size (a skin-tight garment
+    whose right weights are the character's own), scored by stretch and
+    ``deform_mean``/``deform_max`` against those weights.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+
+#: Task names, the first positional argument.
+TASKS = ("skin", "rig", "transfer")
+#: ``--split`` choices: subsets of ``data_split.json``.
+SPLITS = ("all", "train", "validation")
+#: Where the train/validation split lives: the repository's top folder.
+DEFAULT_SPLIT_FILE = Path(__file__).resolve().parent.parent / "data_split.json"
+#: Prefix of the rig method that reads predicted rigs from a folder.
+FILE_METHOD_PREFIX = "file:"
+#: Self-transfer targets are offset along the normals by this share of the
+#: character size (bounding-box diagonal): 0.5 % of a 2 m character is 1 cm,
+#: a tight garment.
+SELF_TRANSFER_OFFSET_FRACTION = 0.005
+#: Name of the extra bone that never moves, used to keep unweighted vertices
+#: in place in the deformation error (as Blender does).
+STATIC_BONE_NAME = "autorig:static"
+#: Significant digits of metric values in the markdown tables.
+TABLE_DIGITS = 4
+
+#: Metric keys of each task, in table order.
+METRIC_KEYS = {
+    "skin": ("l1", "precision", "recall", "deform_mean", "deform_max"),
+    "rig": ("cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit"),
+    "transfer": ("stretch_p99", "stretch_max", "deform_mean", "deform_max"),
+}
+#: Extra per-character keys shown in the tables and summarised.
+EXTRA_KEYS = {"skin": ("unweighted", "seconds"), "rig": ("seconds",), "transfer": ("seconds",)}
+
+
+# --------------------------------------------------------------------------- method registries
+
+
+@dataclass(frozen=True)
+class SkinInput:
+    """What a skin method may look at.
+
+    Attributes
+    ----------
+    mesh : core.types.Mesh, world space, rest pose
+    skeleton : core.types.Skeleton; weights go to its deform bones
+    armature_name : str, the armature object in the loaded scene (for
+        methods that run inside Blender), "" when there is none
+    """
+
+    mesh: object
+    skeleton: object
+    armature_name: str = ""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A registered method: ``predict`` and a one-line description."""
+
+    predict: Callable
+    description: str
+
+
+#: skin methods: ``predict(SkinInput) -> Weights``.
+SKIN_METHODS: dict[str, Method] = {}
+#: rig methods: ``predict(mesh) -> Skeleton`` (world space of the mesh).
+RIG_METHODS: dict[str, Method] = {}
+#: transfer methods: ``predict(source_mesh, source_weights, target_mesh) -> Weights``.
+TRANSFER_METHODS: dict[str, Method] = {}
+
+_REGISTRIES = {"skin": SKIN_METHODS, "rig": RIG_METHODS, "transfer": TRANSFER_METHODS}
+
+
+def register_skin_method(name: str, predict: Callable, description: str) -> None:
+    SKIN_METHODS[name] = Method(predict, description)
+
+
+def register_rig_method(name: str, predict: Callable, description: str) -> None:
+    """Add a skeleton predictor: ``predict(mesh: Mesh) -> Skeleton``."""
+    RIG_METHODS[name] = Method(predict, description)
+
+
+def register_transfer_method(name: str, predict: Callable, description: str) -> None:
+    TRANSFER_METHODS[name] = Method(predict, description)
+
+
+def _bone_heat(task: SkinInput):
+    import bpy
+
+    from .blender.characters import bone_heat_weights
+    from .core.errors import InputError
+
+    armature = bpy.data.objects.get(task.armature_name) if task.armature_name else None
+    if armature is None:
+        raise InputError("Bone heat needs the character's armature in the loaded scene.")
+    return bone_heat_weights(task.mesh, task.skeleton, armature)
+
+
+def _nearest_bone(task: SkinInput):
+    from .core.nearest_bone import nearest_bone_weights
+
+    return nearest_bone_weights(task.mesh, task.skeleton)
+
+
+def _geometric(task: SkinInput):
+    return _geometric_weights_function()(task.mesh, task.skeleton)
+
+
+def _geometric_weights_function():
+    from .core.errors import InputError
+
+    try:
+        from .core.geometric_skinning import geometric_weights
+    except ImportError as error:
+        raise InputError(f"The geometric skinning method is not available in this version ({error}).") from None
+    return geometric_weights
+
+
+def _closest_point_transfer(source, source_weights, target):
+    from .core.closest_point import TriangleMeshQuery
+    from .core.types import Weights
+    from .core.weights import normalize_rows
+
+    points = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
+    return Weights(normalize_rows(points.interpolate(source.triangles, source_weights.matrix)), source_weights.bone_names)
+
+
+def _robust_transfer(source, source_weights, target):
+    from .core.transfer import transfer_weights
+
+    return transfer_weights(source, source_weights, target).weights
+
+
+register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
+register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
+register_skin_method("geometric", _geometric, "core.geometric_skinning.geometric_weights with its defaults")
+register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
+register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")
+
+#: Skin method that returns the reference itself: a sanity check of the
+#: pipeline (its scores must be perfect), not a method.
+REFERENCE_METHOD = "reference"
+
+
+# --------------------------------------------------------------------------- arguments
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the ``eval`` arguments (no Blender needed)."""
+    methods = "; ".join(
+        f"{task}: " + ", ".join(sorted(registry) + ([REFERENCE_METHOD] if task == "skin" else [])
+                                + ([FILE_METHOD_PREFIX + "DIR"] if task == "rig" else []))
+        for task, registry in _REGISTRIES.items()
+    )
+    parser.add_argument("task", choices=TASKS, help="What to evaluate: skin weights, rigs (skeletons) or weight transfer")
+    parser.add_argument("data", nargs="+", metavar="DATA", help="Rigged character files (.blend .glb .gltf .fbx) or folders of them; garments for transfer")
+    parser.add_argument("--method", required=True, help=f"Method to evaluate ({methods})")
+    parser.add_argument("--out", metavar="FILE", help="Write the JSON report to FILE")
+    parser.add_argument("--split", choices=SPLITS, default="all",
+                        help="Keep only the files of this subset of the data split (default all)")
+    parser.add_argument("--split-file", metavar="FILE", default=str(DEFAULT_SPLIT_FILE),
+                        help="The data split (default: data_split.json at the repository top)")
+    parser.add_argument("--source", metavar="FILE", help="transfer: the weighted body whose weights go onto the garments")
+    parser.add_argument("--format", dest="stdout_format", choices=("markdown", "json"), default="markdown",
+                        help="What to print on stdout (default markdown)")
+    parser.add_argument("--baseline", metavar="REPORT", help="A JSON report of another method (from --out) to show beside this one")
+    parser.add_argument("--quiet", action="store_true", help="No per-character progress lines on stderr")
+
+
+# --------------------------------------------------------------------------- data selection
+
+
+@dataclass(frozen=True)
+class DataItem:
+    """One file to evaluate: its path, name and category."""
+
+    path: Path
+    name: str
+    category: str
+
+
+def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None) -> list[DataItem]:
+    """Files to evaluate, named and categorised.
+
+    A folder contributes every loadable file below it, named by its path
+    below the folder without extension; a file is named by its stem. With a
+    split other than ``all``, only files listed in that subset of the split
+    file are kept (matched by the end of their path, since the split holds
+    paths relative to the characters folder). Categories come from the
+    split when it lists the file, else from the folder holding the file.
+
+    Raises
+    ------
+    InputError when nothing is left to evaluate.
+    """
+    from .cli import INPUT_EXTENSIONS
+    from .core import dataset
+    from .core.errors import InputError
+
+    split_path = Path(split_file) if split_file else DEFAULT_SPLIT_FILE
+    split = None
+    if split_name != "all":
+        split = dataset.read_data_split(split_path)
+    elif split_path.is_file():
+        try:
+            split = dataset.read_data_split(split_path)
+        except InputError:
+            split = None  # only used for categories here; the folder names serve as well
+    wanted = set(split.subset(split_name)) if split is not None else set()
+    items = []
+    for text in inputs:
+        root = Path(text)
+        if root.is_dir():
+            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in INPUT_EXTENSIONS]
+            names = [path.relative_to(root).with_suffix("").as_posix() for path in files]
+        elif root.is_file():
+            files, names = [root], [root.stem]
+        else:
+            raise InputError(f"'{text}' is neither a file nor a folder.")
+        for path, name in zip(files, names):
+            entry = _split_entry(path, split)
+            if split_name != "all" and entry not in wanted:
+                continue
+            category = dataset.category_of(entry, split) if entry is not None else path.parent.name
+            items.append(DataItem(path, name, category or "uncategorised"))
+    if not items:
+        where = ", ".join(inputs)
+        if split_name != "all":
+            raise InputError(
+                f"No file under {where} is in the '{split_name}' split of {split_path.name} "
+                "(its paths are relative to the characters folder): pass that folder, or use --split all."
+            )
+        raise InputError(f"No loadable file found in {where}.")
+    return items
+
+
+def _split_entry(path: Path, split) -> Optional[str]:
+    """The split's relative path naming ``path`` (the longest that ends it), if any."""
+    if split is None:
+        return None
+    text = path.resolve().as_posix()
+    matches = [entry for entry in split.subset("all") if text == entry or text.endswith("/" + entry)]
+    return max(matches, key=len) if matches else None
+
+
+# --------------------------------------------------------------------------- scoring
+
+
+def skin_scores(vertices: np.ndarray, predicted, reference, skeleton, poses: Optional[np.ndarray] = None) -> dict:
+    """Skin metrics of ``predicted`` against ``reference`` weights.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64 array, rest positions
+    predicted, reference : Weights (n, *), matched to the deform bones by name
+    skeleton : Skeleton
+    poses : (p, d, 3, 3) float64 array, optional; default
+        ``deformation.random_poses(skeleton)``
+
+    Returns
+    -------
+    dict with ``l1``, ``precision``, ``recall``, ``deform_mean``,
+    ``deform_max`` (see the module docstring) and ``unweighted`` (int).
+    Predicted rows are normalised; vertices without reference weight are
+    left out of every metric.
+    """
+    from .core.deformation import character_size, deformation_error, random_poses
+    from .core.skin_metrics import influence_precision_recall, skin_l1
+    from .core.types import Skeleton
+    from .core.weights import INFLUENCE_EPSILON, normalize_rows
+
+    deform = skeleton.deform_subset()
+    pred = normalize_rows(predicted.select_bones(deform.names).matrix)
+    ref = normalize_rows(reference.select_bones(deform.names).matrix)
+    unweighted = ~(pred > INFLUENCE_EPSILON).any(axis=1)
+    scored = (ref > INFLUENCE_EPSILON).any(axis=1)
+    if poses is None:
+        poses = random_poses(skeleton)
+    influence = influence_precision_recall(pred[scored], ref[scored])
+    # A root bone that never turns holds the vertices left unweighted, so
+    # they stay at rest under every pose, as Blender leaves them.
+    with_static = Skeleton(
+        np.vstack([deform.joints, vertices.mean(axis=0)]), np.append(deform.parents, -1),
+        deform.names + (STATIC_BONE_NAME,), np.vstack([deform.tails, vertices.mean(axis=0) + [0.0, 0.0, 1.0]]),
+    )
+    static_column = unweighted.astype(np.float64)[:, None]
+    identity = np.broadcast_to(np.eye(3), (len(poses), 1, 3, 3))
+    deformation = deformation_error(
+        vertices[scored], np.hstack([pred, static_column])[scored], np.hstack([ref, np.zeros_like(static_column)])[scored],
+        with_static, np.concatenate([poses, identity], axis=1), character_size(vertices),
+    )
+    return {
+        "l1": skin_l1(pred[scored], ref[scored]),
+        "precision": influence["precision"],
+        "recall": influence["recall"],
+        "deform_mean": deformation["mean"],
+        "deform_max": deformation["max"],
+        "unweighted": int(np.count_nonzero(unweighted)),
+    }
+
+
+def self_transfer_target(mesh, size: float):
+    """The character's surface pushed out along its vertex normals by
+    :data:`SELF_TRANSFER_OFFSET_FRACTION` of ``size`` (same vertex order)."""
+    from .core.mesh_ops import vertex_normals
+    from .core.types import Mesh
+
+    offset = SELF_TRANSFER_OFFSET_FRACTION * size * vertex_normals(mesh.vertices, mesh.triangles)
+    return Mesh(mesh.vertices + offset, mesh.triangles, mesh.triangle_polygons, mesh.object_offsets, mesh.object_names)
+
+
+# --------------------------------------------------------------------------- evaluation
+
+
+def _predict_timed(predict: Callable, *args) -> tuple:
+    started = time.perf_counter()
+    result = predict(*args)
+    return result, round(time.perf_counter() - started, 3)
+
+
+def _rig_predictor(method: str) -> Callable:
+    """``predict(mesh, item) -> Skeleton`` for a rig method name."""
+    from .core.errors import InputError
+
+    if method.startswith(FILE_METHOD_PREFIX):
+        folder = Path(method[len(FILE_METHOD_PREFIX):])
+        if not folder.is_dir():
+            raise InputError(f"The folder of predicted rigs '{folder}' does not exist.")
+
+        def read_predicted(mesh, item: DataItem):
+            from .core.rignet_format import read_rignet_rig
+
+            candidates = [folder / f"{item.name}.txt", folder / f"{item.name}_rig.txt",
+                          folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
+            for candidate in candidates:
+                if candidate.is_file():
+                    return read_rignet_rig(candidate)[0]
+            raise InputError(f"No predicted rig for '{item.name}' in '{folder}' (looked for {candidates[0].name}).")
+
+        return read_predicted
+    if method not in RIG_METHODS:
+        raise InputError(f"Unknown rig method '{method}': use {FILE_METHOD_PREFIX}DIR or one of {sorted(RIG_METHODS) or 'none yet'}.")
+    predict = RIG_METHODS[method].predict
+    return lambda mesh, item: predict(mesh)
+
+
+def check_method(task: str, method: str) -> None:
+    """Raise InputError when ``method`` cannot run for ``task``."""
+    from .core.errors import InputError
+
+    if task == "skin":
+        if method != REFERENCE_METHOD and method not in SKIN_METHODS:
+            raise InputError(f"Unknown skin method '{method}': use one of {sorted(SKIN_METHODS) + [REFERENCE_METHOD]}.")
+        if method == "geometric":
+            _geometric_weights_function()
+    elif task == "rig":
+        _rig_predictor(method)
+    elif method not in TRANSFER_METHODS:
+        raise InputError(f"Unknown transfer method '{method}': use one of {sorted(TRANSFER_METHODS)}.")
+
+
+def evaluate_skin_item(item: DataItem, method: str) -> dict:
+    """Load one character, run a skin method on it and score it."""
+    from .blender.characters import load_character
+
+    character = load_character(item.path, item.name, item.category)
+    if method == REFERENCE_METHOD:
+        predicted, seconds = character.weights, 0.0
+    else:
+        task = SkinInput(character.mesh, character.skeleton, character.armature_name)
+        predicted, seconds = _predict_timed(SKIN_METHODS[method].predict, task)
+    scores = skin_scores(character.mesh.vertices, predicted, character.weights, character.skeleton)
+    return {**scores, "seconds": seconds, "vertices": character.mesh.vertex_count,
+            "reference_unweighted": character.unweighted_count}
+
+
+def evaluate_rig_item(item: DataItem, method: str) -> dict:
+    """Load one character, predict its rig from the mesh alone and score it."""
+    from .blender.characters import load_character
+    from .core.skeleton_metrics import evaluate_rig
+
+    character = load_character(item.path, item.name, item.category)
+    predicted, seconds = _predict_timed(_rig_predictor(method), character.mesh, item)
+    return {**evaluate_rig(predicted, character.skeleton, character.size), "seconds": seconds}
+
+
+@dataclass
+class _TransferSource:
+    """The body of a garment transfer, loaded once."""
+
+    mesh: object
+    weights: object
+    skeleton: object
+
+
+def load_transfer_source(path: Optional[str]) -> Optional[_TransferSource]:
+    if not path:
+        return None
+    from .blender.characters import load_character
+
+    body = load_character(path)
+    return _TransferSource(body.mesh, body.weights, body.skeleton)
+
+
+def _garment_mesh():
+    """Every mesh with faces in the loaded scene, as one Mesh."""
+    import bpy
+
+    from .blender import convert
+    from .core.errors import InputError
+
+    objects = [obj for obj in bpy.context.scene.objects if obj.type == "MESH" and len(obj.data.polygons)]
+    if not objects:
+        raise InputError("The garment file holds no mesh with faces.")
+    return convert.read_mesh(sorted(objects, key=lambda obj: obj.name), bpy.context.evaluated_depsgraph_get())
+
+
+def evaluate_transfer_item(item: DataItem, method: str, source: Optional[_TransferSource]) -> dict:
+    """Transfer onto one DATA file: a self-transfer check for a rigged
+    character, a garment transfer from ``source`` otherwise."""
+    from .blender import characters, scene_io
+    from .core.deformation import unique_edges
+    from .core.errors import InputError
+    from .core.skin_metrics import evaluate_transfer
+
+    scene_io.load_scene(item.path)
+    try:
+        characters.choose_armature()
+        rigged = True
+    except InputError:
+        rigged = False
+    predict = TRANSFER_METHODS[method].predict
+    if rigged:
+        character = characters.read_character(item.name, str(item.path), item.category)
+        target = self_transfer_target(character.mesh, character.size)
+        predicted, seconds = _predict_timed(predict, character.mesh, character.weights, target)
+        scores = evaluate_transfer(
+            target.vertices, unique_edges(target.triangles), predicted, character.skeleton, character.weights,
+        )
+        return {**scores, "seconds": seconds, "kind": "self", "vertices": target.vertex_count}
+    if source is None:
+        raise InputError(f"'{item.name}' is not rigged, so it is a garment: give the body with --source.")
+    target = _garment_mesh()
+    predicted, seconds = _predict_timed(predict, source.mesh, source.weights, target)
+    scores = evaluate_transfer(target.vertices, unique_edges(target.triangles), predicted, source.skeleton)
+    return {**scores, "seconds": seconds, "kind": "garment", "vertices": target.vertex_count}
+
+
+def evaluate(task: str, method: str, items: list[DataItem], source_path: Optional[str] = None, log=None) -> dict:
+    """Run ``method`` on every item; one failure does not stop the others.
+
+    Returns
+    -------
+    dict: ``task``, ``method``, ``characters`` (one dict per item) and
+    ``summary`` (:func:`summarise`).
+    """
+    from .cli import stdout_to_stderr
+
+    check_method(task, method)
+    with stdout_to_stderr():
+        source = load_transfer_source(source_path) if task == "transfer" else None
+    characters = []
+    for index, item in enumerate(items):
+        entry = {"name": item.name, "category": item.category, "path": str(item.path)}
+        try:
+            with stdout_to_stderr():
+                if task == "skin":
+                    entry.update(evaluate_skin_item(item, method))
+                elif task == "rig":
+                    entry.update(evaluate_rig_item(item, method))
+                else:
+                    entry.update(evaluate_transfer_item(item, method, source))
+            outcome = "ok"
+        except Exception as error:  # noqa: BLE001 - one bad character must not stop the evaluation
+            entry["error"] = str(error) or type(error).__name__
+            outcome = f"FAILED: {entry['error']}"
+        characters.append(entry)
+        if log is not None:
+            log(f"[{index + 1}/{len(items)}] {item.name}: {outcome}")
+    return {"task": task, "method": method, "characters": characters, "summary": summarise(task, characters)}
+
+
+def summarise(task: str, characters: list[dict]) -> dict:
+    """Mean and median of every metric per category and over all characters.
+
+    Returns
+    -------
+    dict: ``categories`` maps each category to ``{"count", "failed",
+    "mean": {key: value}, "median": {key: value}}``; ``overall`` is the same
+    over every character. Failed characters only count in ``failed``; a
+    metric no character has (e.g. ``deform_mean`` of garments) is left out.
+    """
+    keys = METRIC_KEYS[task] + EXTRA_KEYS[task]
+    groups: dict[str, list[dict]] = {}
+    for entry in characters:
+        groups.setdefault(entry["category"], []).append(entry)
+
+    def statistics(entries: list[dict]) -> dict:
+        done = [entry for entry in entries if "error" not in entry]
+        result = {"count": len(done), "failed": len(entries) - len(done), "mean": {}, "median": {}}
+        for key in keys:
+            values = [float(entry[key]) for entry in done if key in entry]
+            if values:
+                result["mean"][key] = float(np.mean(values))
+                result["median"][key] = float(np.median(values))
+        return result
+
+    return {
+        "categories": {category: statistics(entries) for category, entries in sorted(groups.items())},
+        "overall": statistics(characters),
+    }
+
+
+# --------------------------------------------------------------------------- output
+
+
+def _cell(value) -> str:
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, float):
+        return f"{value:.{TABLE_DIGITS}g}"
+    return str(value)
+
+
+def markdown_report(report: dict, baseline: Optional[dict] = None) -> str:
+    """The report as markdown: one table per category, then the summary.
+
+    With a ``baseline`` report (same task, e.g. ``boneheat``), each metric
+    cell reads ``ours / baseline`` where the baseline scored that character,
+    and the summary compares the means.
+    """
+    task = report["task"]
+    keys = METRIC_KEYS[task] + EXTRA_KEYS[task]
+    base_entries = _matching_entries(report, baseline) if baseline else {}
+    title = f"## {task}: {report['method']}" + (f" (/ {baseline['method']})" if baseline else "")
+    lines = [title, ""]
+    by_category: dict[str, list[dict]] = {}
+    for entry in report["characters"]:
+        by_category.setdefault(entry["category"], []).append(entry)
+    for category, entries in sorted(by_category.items()):
+        shown = [key for key in keys if any(key in entry for entry in entries)] or list(METRIC_KEYS[task])
+        lines += [f"### {category}", "", "| character | " + " | ".join(shown) + " |", "|---" * (len(shown) + 1) + "|"]
+        for entry in entries:
+            if "error" in entry:
+                message = entry["error"].replace("|", "/").replace("\n", " ")
+                lines.append(f"| {entry['name']} | failed: {message} |" + " |" * (len(shown) - 1))
+                continue
+            base = base_entries.get(entry["path"], {})
+            cells = [_cell(entry.get(key, "")) + (f" / {_cell(base[key])}" if key in base else "") for key in shown]
+            lines.append(f"| {entry['name']} | " + " | ".join(cells) + " |")
+        lines.append("")
+    summary = report["summary"]
+    # The baseline is summarised over the characters both reports scored, so the means compare like with like.
+    base_summary = summarise(task, list(base_entries.values())) if baseline else {}
+    base_rows = dict(base_summary.get("categories", {}), **({"**overall**": base_summary["overall"]} if base_summary else {}))
+    shown = [key for key in keys if key in summary["overall"]["mean"]]
+    heading = "### Summary (mean / median)" if not baseline else f"### Summary (mean: {report['method']} / {baseline['method']})"
+    lines += [heading, "", "| category | n | failed | " + " | ".join(shown) + " |", "|---" * (len(shown) + 3) + "|"]
+    rows = list(summary["categories"].items()) + [("**overall**", summary["overall"])]
+    for category, statistics in rows:
+        other = base_rows.get(category, {}).get("mean", {}) if baseline else None
+        cells = []
+        for key in shown:
+            if key not in statistics["mean"]:
+                cells.append("")
+            elif baseline:
+                cells.append(_cell(statistics["mean"][key]) + (f" / {_cell(other[key])}" if key in other else ""))
+            else:
+                cells.append(f"{_cell(statistics['mean'][key])} / {_cell(statistics['median'][key])}")
+        lines.append(f"| {category} | {statistics['count']} | {statistics['failed']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _matching_entries(report: dict, baseline: dict) -> dict:
+    """Baseline entries scored for the same files as ``report``'s, by path."""
+    scored = {str(Path(entry["path"]).resolve()): entry for entry in baseline["characters"] if "error" not in entry}
+    matched = {}
+    for entry in report["characters"]:
+        other = scored.get(str(Path(entry["path"]).resolve()))
+        if other is not None:
+            matched[entry["path"]] = {**other, "category": entry["category"]}
+    return matched
+
+
+def _read_baseline(path: str, task: str) -> dict:
+    from .core.errors import InputError
+
+    try:
+        baseline = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise InputError(f"Cannot read the baseline report '{path}': {error}") from None
+    if baseline.get("task") != task or "characters" not in baseline:
+        raise InputError(f"'{path}' is not a report of an '{task}' evaluation (write one with --out).")
+    return baseline
+
+
+def run(args: argparse.Namespace) -> int:
+    """The ``eval`` subcommand. Exit code 0 when every character was scored,
+    1 when some failed (they are in the report with their error)."""
+    from .cli import EXIT_FAILED, EXIT_OK
+
+    items = collect_data(args.data, args.split, args.split_file)
+    log = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    baseline = _read_baseline(args.baseline, args.task) if args.baseline else None
+    report = evaluate(args.task, args.method, items, args.source, log)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
+    sys.stdout.write(json.dumps(report, indent=2) + "\n" if args.stdout_format == "json" else markdown_report(report, baseline))
+    sys.stdout.flush()
+    return EXIT_FAILED if any("error" in entry for entry in report["characters"]) else EXIT_OK

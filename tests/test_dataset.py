@@ -1,0 +1,264 @@
+"""Normalisation, samples, cache and data split (autorig_addon.core.dataset), no Blender."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from autorig_addon.core import dataset
+from autorig_addon.core.dataset import (
+    FACING_AS_NAMED,
+    FACING_TURNED,
+    FACING_UNKNOWN,
+    CharacterSample,
+    apply_transform,
+    bone_side,
+    build_samples,
+    normalise,
+    read_data_split,
+)
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.types import Mesh, Skeleton, Weights
+from geometry_fixtures import cylinder
+
+
+def biped(facing_plus_y: bool) -> tuple:
+    """A box-ish "character" 1.8 tall standing at (3, -2, 0.5) with arms named
+    .L/.R; facing -Y puts the left arm at +X (Blender convention)."""
+    body = cylinder(radius=0.25, height=1.8, segments=12, rings=10, z0=0.5)
+    vertices = body.vertices + [3.0, -2.0, 0.0]
+    side = -1.0 if facing_plus_y else 1.0
+    skeleton = Skeleton(
+        joints=[[3.0, -2.0, 1.4], [3.0, -2.0, 2.0], [3.0 + side * 0.2, -2.0, 2.0], [3.0 - side * 0.2, -2.0, 2.0]],
+        parents=[-1, 0, 1, 1],
+        names=("Hips", "Chest", "UpperArm.L", "UpperArm.R"),
+        tails=[[3.0, -2.0, 2.0], [3.0, -2.0, 2.2], [3.0 + side * 0.5, -2.0, 2.0], [3.0 - side * 0.5, -2.0, 2.0]],
+    )
+    return Mesh(vertices, body.triangles), skeleton
+
+
+@pytest.mark.parametrize(
+    ("name", "side"),
+    [
+        ("UpperArm.L", 1), ("hand.r", -1), ("Foot_L", 1), ("toe_r", -1), ("L_Hand", 1), ("r.leg", -1),
+        ("mixamorig:LeftArm", 1), ("B_Knee_Right", -1), ("Spine", 0), ("Tail", 0), ("Lower", 0), ("Root", 0),
+        ("LeftRight", 0),
+    ],
+)
+def test_bone_side_from_names(name, side):
+    assert bone_side(name) == side
+
+
+def test_normalise_puts_feet_at_zero_centres_and_scales_to_unit_height():
+    mesh, skeleton = biped(facing_plus_y=False)
+    result = normalise(mesh, skeleton)
+    low, high = result.mesh.vertices.min(axis=0), result.mesh.vertices.max(axis=0)
+    assert low[2] == pytest.approx(0.0, abs=1e-12)
+    # The tallest side (1.8 high, 0.5 wide) becomes 1.
+    assert high[2] - low[2] == pytest.approx(1.0)
+    np.testing.assert_allclose((low[:2] + high[:2]) / 2.0, [0.0, 0.0], atol=1e-12)
+    assert result.facing == FACING_AS_NAMED
+    # The transform maps the original joints onto the moved ones.
+    np.testing.assert_allclose(apply_transform(skeleton.joints, result.transform), result.skeleton.joints, atol=1e-12)
+    # Hips at height 1.4 - 0.5 above the feet, divided by the 1.8 height.
+    assert result.skeleton.joints[0, 2] == pytest.approx(0.9 / 1.8)
+    np.testing.assert_array_equal(result.mesh.triangles, mesh.triangles)
+
+
+def test_normalise_turns_a_character_facing_plus_y():
+    mesh, skeleton = biped(facing_plus_y=True)
+    assert skeleton.joints[2, 0] < skeleton.joints[3, 0]  # UpperArm.L at -X: faces +Y
+    result = normalise(mesh, skeleton)
+    assert result.facing == FACING_TURNED
+    left, right = result.skeleton.joints[2], result.skeleton.joints[3]
+    assert left[0] == pytest.approx(0.2 / 1.8) and right[0] == pytest.approx(-0.2 / 1.8)
+    # A half turn about z: x and y change sign, heights stay.
+    np.testing.assert_allclose(result.transform[:3, :3], np.diag([-1.0, -1.0, 1.0]) / 1.8, atol=1e-12)
+    assert np.linalg.det(result.transform[:3, :3]) > 0  # triangles keep their orientation
+
+
+def test_normalise_turns_a_character_facing_sideways_by_a_quarter():
+    mesh, skeleton = biped(facing_plus_y=False)
+    # Turn the whole character 90 degrees counter-clockwise: it faces +X, its left is at +Y.
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    turned_mesh = Mesh(mesh.vertices @ turn.T, mesh.triangles)
+    turned = Skeleton(skeleton.joints @ turn.T, skeleton.parents, skeleton.names, skeleton.tails @ turn.T)
+    assert dataset.facing_quarter_turns(turned) == 3
+    result = normalise(turned_mesh, turned)
+    assert result.facing == FACING_TURNED
+    expected = normalise(mesh, skeleton)
+    np.testing.assert_allclose(result.skeleton.joints, expected.skeleton.joints, atol=1e-12)
+    np.testing.assert_allclose(result.mesh.vertices, expected.mesh.vertices, atol=1e-12)
+
+
+def test_subdivide_midpoints_keeps_the_shape_and_interpolates():
+    vertices = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]])
+    triangles = np.array([[0, 1, 2], [1, 3, 2]])
+    values = np.array([[0.0], [1.0], [2.0], [3.0]])  # = x / 2 + y, linear
+    new_vertices, new_triangles, new_values = dataset.subdivide_midpoints(vertices, triangles, values)
+    assert len(new_vertices) == 4 + 5 and len(new_triangles) == 8  # five edges, four children each
+    np.testing.assert_array_equal(new_vertices[:4], vertices)
+    np.testing.assert_allclose(new_values[:, 0], new_vertices[:, 0] / 2 + new_vertices[:, 1])
+    a, b, c = (new_vertices[new_triangles[:, k]] for k in range(3))
+    normals = np.cross(b - a, c - a)
+    # Each child is a quarter of its parent (area 2): area 0.5, so |cross| = 1, facing +z like the parent.
+    np.testing.assert_allclose(normals[:, 2], 1.0)
+    np.testing.assert_allclose(normals[:, :2], 0.0)
+
+
+def test_normalise_keeps_orientation_when_names_say_nothing():
+    mesh, skeleton = biped(facing_plus_y=True)
+    anonymous = Skeleton(skeleton.joints, skeleton.parents, ("a", "b", "c", "d"), skeleton.tails)
+    result = normalise(mesh, anonymous)
+    assert result.facing == FACING_UNKNOWN
+    assert result.transform[0, 0] > 0
+
+
+def test_long_animals_are_scaled_by_their_longest_side():
+    body = cylinder(radius=0.1, height=4.0, segments=8, rings=5)
+    lying = Mesh(body.vertices[:, [2, 0, 1]], body.triangles)  # 4 long along x, 0.2 high
+    skeleton = Skeleton([[0.0, 0.0, 0.0]], [-1], ("Spine",), [[4.0, 0.0, 0.0]])
+    result = normalise(lying, skeleton)
+    extent = result.mesh.vertices.max(axis=0) - result.mesh.vertices.min(axis=0)
+    np.testing.assert_allclose(extent, [1.0, 0.05, 0.05], atol=1e-12)
+
+
+def make_sample(name="Guy", category="biped"):
+    mesh, skeleton = biped(facing_plus_y=True)
+    z = mesh.vertices[:, 2]
+    upper = np.clip((z - 1.6) / 0.4, 0.0, 1.0)
+    weights = Weights(np.column_stack([1 - upper, upper, np.zeros_like(z), np.zeros_like(z)]),
+                      ("Hips", "Chest", "UpperArm.L", "UpperArm.R"))
+    return CharacterSample.from_character(name, category, mesh, skeleton, weights), mesh, weights
+
+
+def test_sample_round_trip(tmp_path):
+    sample, mesh, weights = make_sample()
+    assert sample.facing == FACING_TURNED
+    assert sample.weights.shape == (mesh.vertex_count, 4)
+    np.testing.assert_allclose(sample.weights, weights.matrix)
+    path = tmp_path / "guy.npz"
+    sample.save(path)
+    loaded = CharacterSample.load(path)
+    for key in ("vertices", "triangles", "joints", "parents", "tails", "deform", "weights", "transform"):
+        np.testing.assert_array_equal(getattr(loaded, key), getattr(sample, key))
+    assert loaded.names == sample.names and loaded.name == "Guy" and loaded.category == "biped"
+    assert loaded.facing == FACING_TURNED and loaded.source_vertex_count == mesh.vertex_count
+    # The stored transform takes the original mesh onto the stored vertices.
+    np.testing.assert_allclose(apply_transform(mesh.vertices, loaded.transform), loaded.vertices, atol=1e-12)
+    assert loaded.skin.bone_names == ("Hips", "Chest", "UpperArm.L", "UpperArm.R")
+
+
+def test_loading_another_format_version_is_an_input_error(tmp_path):
+    sample, _, _ = make_sample()
+    path = tmp_path / "old.npz"
+    sample.save(path)
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["format_version"] = np.int64(dataset.SAMPLE_FORMAT_VERSION + 1)
+    np.savez(path, **arrays)
+    with pytest.raises(InputError, match="format"):
+        CharacterSample.load(path)
+
+
+class CountingLoader:
+    """Stands in for the Blender loader: returns the biped, counts calls."""
+
+    def __init__(self):
+        self.calls = []
+
+    def __call__(self, path, target_vertices):
+        self.calls.append((path.name, target_vertices))
+        sample, mesh, weights = make_sample(name=path.stem)
+        _, skeleton = biped(facing_plus_y=True)
+        return SimpleNamespace(name=path.stem, category="biped", mesh=mesh, skeleton=skeleton, weights=weights)
+
+
+def character_files(tmp_path, count=2):
+    paths = []
+    for index in range(count):
+        path = tmp_path / "data" / f"char{index}.glb"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(f"fake character {index}".encode())
+        paths.append(path)
+    return paths
+
+
+def test_build_samples_caches_and_reuses(tmp_path):
+    paths = character_files(tmp_path)
+    loader = CountingLoader()
+    first = build_samples(paths, loader, tmp_path / "cache", target_vertices=2000)
+    assert [call[0] for call in loader.calls] == ["char0.glb", "char1.glb"]
+    assert all(call[1] == 2000 for call in loader.calls)
+    assert len(list((tmp_path / "cache").glob("*.npz"))) == 2
+    second = build_samples(paths, loader, tmp_path / "cache", target_vertices=2000)
+    assert len(loader.calls) == 2  # nothing loaded again
+    for built, cached in zip(first, second):
+        np.testing.assert_array_equal(built.vertices, cached.vertices)
+        np.testing.assert_array_equal(built.weights, cached.weights)
+        assert built.name == cached.name
+    # Other parameters or changed content make new samples.
+    build_samples(paths, loader, tmp_path / "cache", target_vertices=1000)
+    assert len(loader.calls) == 4
+    paths[0].write_bytes(b"edited")
+    build_samples(paths, loader, tmp_path / "cache", target_vertices=2000)
+    assert [call[0] for call in loader.calls[4:]] == ["char0.glb"]
+
+
+def test_builds_are_reproducible(tmp_path):
+    paths = character_files(tmp_path, count=1)
+    one = build_samples(paths, CountingLoader(), tmp_path / "a")[0]
+    two = build_samples(paths, CountingLoader(), tmp_path / "b")[0]
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == sorted(p.name for p in (tmp_path / "b").iterdir())
+    for key in ("vertices", "triangles", "joints", "weights", "transform"):
+        np.testing.assert_array_equal(getattr(one, key), getattr(two, key))
+
+
+def test_cache_folder_follows_the_environment(tmp_path, monkeypatch):
+    monkeypatch.setenv(dataset.CACHE_ENVIRONMENT_VARIABLE, str(tmp_path / "root"))
+    assert dataset.default_cache_dir() == tmp_path / "root" / "samples"
+    paths = character_files(tmp_path, count=1)
+    build_samples(paths, CountingLoader())
+    assert len(list((tmp_path / "root" / "samples").glob("char0-*.npz"))) == 1
+    monkeypatch.delenv(dataset.CACHE_ENVIRONMENT_VARIABLE)
+    assert dataset.default_cache_dir() == dataset.DEFAULT_CACHE_ROOT.expanduser() / "samples"
+
+
+def test_gltf_hash_covers_its_buffer(tmp_path):
+    document = {"asset": {"version": "2.0"}, "buffers": [{"uri": "mesh.bin", "byteLength": 4}]}
+    gltf = tmp_path / "c.gltf"
+    gltf.write_text(json.dumps(document))
+    (tmp_path / "mesh.bin").write_bytes(b"\x00\x01\x02\x03")
+    before = dataset.file_content_hash(gltf)
+    (tmp_path / "mesh.bin").write_bytes(b"\x00\x01\x02\x04")
+    assert dataset.file_content_hash(gltf) != before
+
+
+def test_too_coarse_target_is_an_input_error(tmp_path):
+    with pytest.raises(InputError, match="too coarse"):
+        build_samples(character_files(tmp_path, 1), CountingLoader(), tmp_path / "cache", target_vertices=10)
+
+
+def test_data_split_in_both_category_layouts(tmp_path):
+    by_category = {"train": ["a/x.glb", "b/y.glb"], "validation": ["a/z.glb"],
+                   "categories": {"animal": ["a/x.glb", "a/z.glb"], "human": ["b/y.glb"]}}
+    by_path = {"train": ["a/x.glb"], "validation": ["a/z.glb"], "categories": {"a/x.glb": "animal"}}
+    (tmp_path / "one.json").write_text(json.dumps(by_category))
+    (tmp_path / "two.json").write_text(json.dumps(by_path))
+    split = read_data_split(tmp_path / "one.json")
+    assert split.validation == ("a/z.glb",) and split.subset("all") == ("a/x.glb", "b/y.glb", "a/z.glb")
+    assert dataset.category_of("b/y.glb", split) == "human"
+    assert dataset.category_of("c/w.glb", split) == "c"
+    assert dataset.category_of("a/x.glb", read_data_split(tmp_path / "two.json")) == "animal"
+    assert dataset.select_split(["a/z.glb", "b/y.glb"], split, "validation") == [0]
+    with pytest.raises(InputError, match="train"):
+        (tmp_path / "bad.json").write_text("[]")
+        read_data_split(tmp_path / "bad.json")
+
+
+def test_relative_names(tmp_path):
+    path = tmp_path / "pack" / "Fox.glb"
+    assert dataset.relative_name(path, tmp_path) == "pack/Fox"
+    assert dataset.relative_name(path) == "Fox"
+    assert dataset.relative_name(path, tmp_path / "elsewhere") == "Fox"

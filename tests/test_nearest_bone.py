@@ -1,0 +1,72 @@
+"""Nearest-bone weights (autorig_addon.core.nearest_bone), numbers by hand."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core import nearest_bone
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.nearest_bone import closest_segments, nearest_bone_weights
+from autorig_addon.core.types import Mesh, Skeleton
+from geometry_fixtures import cylinder, two_bone_skeleton
+
+
+def test_two_bone_cylinder_splits_at_the_joint():
+    # Radius 0.1, height 1, rings every 0.05; bones lower (0 to 0.5) and upper (0.5 to 1).
+    mesh = cylinder(radius=0.1, height=1.0, segments=8, rings=21)
+    weights = nearest_bone_weights(mesh, two_bone_skeleton())
+    z = mesh.vertices[:, 2]
+    assert weights.bone_names == ("lower", "upper")
+    # A side vertex at height z < 0.5 is 0.1 from the lower bone and
+    # sqrt(0.01 + (0.5 - z)^2) > 0.1 from the upper one, and the reverse above.
+    np.testing.assert_array_equal(weights.matrix[z < 0.5 - 1e-9], [[1.0, 0.0]] * int(np.sum(z < 0.5 - 1e-9)))
+    np.testing.assert_array_equal(weights.matrix[z > 0.5 + 1e-9], [[0.0, 1.0]] * int(np.sum(z > 0.5 + 1e-9)))
+    # On the joint ring both bones are 0.1 away: the first bone wins the tie.
+    on_joint = np.isclose(z, 0.5)
+    assert on_joint.sum() == 8
+    np.testing.assert_array_equal(weights.matrix[on_joint, 0], np.ones(8))
+
+
+def test_non_deform_bones_get_no_column():
+    skeleton = Skeleton(
+        joints=[[0, 0, 0], [0, 0, 0.5], [0.0, 0.0, 0.2]], parents=[-1, 0, 0], names=("lower", "upper", "control"),
+        tails=[[0, 0, 0.5], [0, 0, 1.0], [0.0, 0.0, 0.3]], deform=[True, True, False],
+    )
+    mesh = cylinder(radius=0.1, height=1.0, segments=6, rings=11)
+    weights = nearest_bone_weights(mesh, skeleton)
+    assert weights.bone_names == ("lower", "upper")
+    # The control bone sits inside the lower half; without it the lower half still goes to "lower".
+    z = mesh.vertices[:, 2]
+    assert np.all(weights.matrix[z < 0.45, 0] == 1.0)
+
+
+def test_distances_to_segments_by_hand():
+    starts = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    ends = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])  # the second is a point
+    points = np.array([[0.5, 0.3, 0.0], [-1.0, 0.0, 0.0], [2.0, 0.0, 0.4], [1.6, 0.0, 0.0]])
+    index, distance = closest_segments(points, starts, ends)
+    np.testing.assert_array_equal(index, [0, 0, 1, 1])
+    np.testing.assert_allclose(distance, [0.3, 1.0, 0.4, 0.4])
+
+
+def test_chunking_gives_the_same_answer(monkeypatch):
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(1000, 3))
+    starts, ends = rng.normal(size=(7, 3)), rng.normal(size=(7, 3))
+    whole_index, whole_distance = closest_segments(points, starts, ends)
+    monkeypatch.setattr(nearest_bone, "POINT_CHUNK", 64)
+    chunk_index, chunk_distance = closest_segments(points, starts, ends)
+    np.testing.assert_array_equal(whole_index, chunk_index)
+    np.testing.assert_allclose(whole_distance, chunk_distance)
+    # Brute force: sample every segment densely; the closest sample is within one step.
+    t = np.linspace(0.0, 1.0, 2001)[:, None, None]
+    samples = (starts[None] + t * (ends - starts)[None]).reshape(-1, 3)
+    brute = np.linalg.norm(points[:, None, :] - samples[None], axis=2).min(axis=1)
+    step = np.linalg.norm(ends - starts, axis=1).max() / 2000
+    assert np.all(whole_distance <= brute + 1e-12)
+    assert np.all(brute - whole_distance <= step)
+
+
+def test_skeleton_without_deform_bones_is_an_input_error():
+    skeleton = Skeleton([[0, 0, 0]], [-1], ("only",), [[0, 0, 1]], [False])
+    with pytest.raises(InputError, match="no deform bones"):
+        nearest_bone_weights(Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]), skeleton)
