@@ -2,6 +2,7 @@
 
 import bpy
 
+from .operators_skin import AUTORIG_OT_skin_weights
 from .operators_transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
 
 #: Sidebar tab the add-on's panels live in.
@@ -92,4 +93,42 @@ class VIEW3D_PT_autorig_transfer(bpy.types.Panel):
         layout.operator(AUTORIG_OT_transfer_weights.bl_idname, icon="MOD_VERTEX_WEIGHT")
 
 
-classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_transfer)
+class VIEW3D_PT_autorig_skin(bpy.types.Panel):
+    bl_label = "Skin Weights"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = SIDEBAR_CATEGORY
+    bl_parent_id = "VIEW3D_PT_autorig"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "autorig", None) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.autorig
+        armatures = [obj.name for obj in context.selected_objects if obj.type == "ARMATURE"]
+        meshes = [obj.name for obj in context.selected_objects if obj.type == "MESH"]
+        column = layout.column(align=True)
+        if len(armatures) == 1 and meshes:
+            shown = ", ".join(meshes[:3]) + (f" +{len(meshes) - 3}" if len(meshes) > 3 else "")
+            column.label(text=f"{shown} to {armatures[0]}", icon="ARMATURE_DATA")
+        else:
+            column.label(text="Select the meshes and one armature", icon="INFO")
+
+        column = layout.column(align=True)
+        column.prop(settings, "skin_distance")
+        column.prop(settings, "skin_resolution")
+        column.prop(settings, "skin_falloff")
+        column.prop(settings, "skin_max_influences")
+        column.prop(settings, "skin_smoothing_iterations")
+        row = column.row()
+        row.active = settings.skin_smoothing_iterations > 0
+        row.prop(settings, "skin_smoothing_strength")
+        column.prop(settings, "skin_replace_all")
+        layout.operator(AUTORIG_OT_skin_weights.bl_idname, icon="MOD_ARMATURE")
+
+
+classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_transfer, VIEW3D_PT_autorig_skin)

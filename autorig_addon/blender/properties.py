@@ -138,6 +138,63 @@ class TransferOptionProperties:
 TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
 
 
+#: Default voxels along the longest side for skinning distances (both papers: 88).
+DEFAULT_SKIN_RESOLUTION = 88
+#: Default exponent of the distance falloff of geometric skinning.
+DEFAULT_SKIN_FALLOFF = 2.0
+#: Default bones per vertex after skinning.
+DEFAULT_SKIN_MAX_INFLUENCES = 4
+#: Default surface smoothing passes after skinning.
+DEFAULT_SKIN_SMOOTHING_ITERATIONS = 2
+
+SKIN_DISTANCE_ITEMS = (
+    ("GEODESIC", "Volumetric Geodesic",
+     "Shortest path through the inside of the mesh (RigNet, Geodesic Voxel Binding); for closed bodies"),
+    ("HOLLOW", "HollowDist",
+     "Paths through empty space around the mesh (HeterSkinNet); reaches bones outside the body and loose parts"),
+)
+
+
+class SkinOptionProperties:
+    """Skinning options shared by :class:`AutoRigSceneSettings` and the skin operator."""
+
+    skin_distance: EnumProperty(
+        name="Distance", description="How the distance from a vertex to a bone is measured",
+        items=SKIN_DISTANCE_ITEMS, default="GEODESIC",
+    )
+    skin_resolution: IntProperty(
+        name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "
+        "(fingers, cloth) better and costs more time and memory",
+        min=16, max=512, soft_max=256, default=DEFAULT_SKIN_RESOLUTION,
+    )
+    skin_falloff: FloatProperty(
+        name="Falloff", description="Exponent of how fast a bone's influence falls with distance "
+        "(weight ~ 1 / distance^falloff); higher gives sharper joints",
+        min=0.5, max=8.0, default=DEFAULT_SKIN_FALLOFF,
+    )
+    skin_max_influences: IntProperty(
+        name="Max Influences", description="Bones per vertex to keep (0 = no limit; 4 for most game engines)",
+        min=0, max=MAX_INFLUENCES_LIMIT, default=DEFAULT_SKIN_MAX_INFLUENCES,
+    )
+    skin_smoothing_iterations: IntProperty(
+        name="Smoothing", description="Laplacian smoothing passes of the weights over the surface",
+        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SKIN_SMOOTHING_ITERATIONS,
+    )
+    skin_smoothing_strength: FloatProperty(
+        name="Smoothing Strength", description="Blend factor of one smoothing pass",
+        subtype="FACTOR", min=0.0, max=1.0, default=DEFAULT_SMOOTHING_STRENGTH,
+    )
+    skin_replace_all: BoolProperty(
+        name="Replace All Groups", description="Remove every existing vertex group of the meshes first "
+        "(otherwise only the deform bones' groups are replaced)",
+        default=False,
+    )
+
+
+#: Names of the skin options, as declared on :class:`SkinOptionProperties`.
+SKIN_OPTION_NAMES = tuple(SkinOptionProperties.__annotations__)
+
+
 def _is_weighted_mesh(_self, obj) -> bool:
     return obj.type == "MESH" and len(obj.vertex_groups) > 0
 
@@ -146,7 +203,7 @@ def _is_mesh(_self, obj) -> bool:
     return obj.type == "MESH"
 
 
-class AutoRigSceneSettings(TransferOptionProperties, bpy.types.PropertyGroup):
+class AutoRigSceneSettings(TransferOptionProperties, SkinOptionProperties, bpy.types.PropertyGroup):
     """Settings of the AutoRig panels, stored per scene."""
 
     source: PointerProperty(
