@@ -1,0 +1,204 @@
+"""Volumetric geodesic distance from vertices to bones.
+
+The length of the shortest path from a vertex to a bone that stays inside
+the shape (RigNet, Xu et al. 2020, after Dionne & de Lasa's Geodesic Voxel
+Binding, 2013). Paths run through the solid cells of a voxel grid (surface
+cells and the filled interior), so the distance from a fingertip to the
+other hand goes up the arm and across the chest, not through the air.
+
+Method (see :mod:`.voxelize` for the shared stages):
+
+* Voxelise the surface conservatively and fill the enclosed interior.
+* Graph: solid cells, 26-connected, each step as long as the distance
+  between cell centres; interior cells away from the surface and the bones
+  merge into blocks to keep the graph small.
+* Each bone is a virtual source joined to the solid cells it crosses, at the
+  distance from the cell centre to the bone segment.
+* A bone does not always cross every solid part: it may lie outside the
+  body (a skirt bone) and a part may be disconnected (a hat, a ball held in
+  a hand). The bone then jumps straight through the air to the part's
+  nearest cell at :data:`OUTSIDE_JUMP_PENALTY` times the jump length, so
+  every vertex of every part gets a finite distance and the jump still
+  counts against the bone.
+* Dijkstra per bone; a vertex's distance is the best of its own and the 26
+  surrounding cells: that cell's distance plus the straight step from its
+  centre to the vertex.
+* Line of sight (as RigNet does): where the straight segment from a vertex
+  to the nearest point of a bone stays in solid cells, the distance is that
+  segment's length, exactly.
+
+Accuracy: graph paths measure steps along axes and 45-degree diagonals
+exactly; other directions are measured along a staircase of 26-neighbour
+steps, at most 12.8 % longer than the straight line (8.2 % within an axis
+plane). The line-of-sight pass removes that error wherever the bone is
+visible from the vertex, which covers the bones that matter most for
+skinning; paths that must bend around the surface keep it. Cells are
+``longest side / resolution`` wide, so surfaces are located to half a cell.
+
+Units: distances are in scene units (those of the mesh vertices).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from .progress import ProgressCallback, report, sub_progress
+from .types import Mesh
+from .voxelize import (
+    DEFAULT_RESOLUTION,
+    BoneGraph,
+    VoxelGrid,
+    assemble_bone_graph,
+    bone_mask,
+    bone_node_distances,
+    combine_vertex_distances,
+    dilate,
+    fill_interior,
+    fill_unreached,
+    merge_cells,
+    neighbour_node_pairs,
+    paired_point_segment_distances,
+    point_segment_distances,
+    refine_in_sight,
+    segment_cells,
+    validate_bones,
+    vertex_cell_candidates,
+    voxelize_surface,
+)
+
+#: A jump through the air from a bone to a solid part it does not cross
+#: counts this many times its straight length.
+OUTSIDE_JUMP_PENALTY = 2.0
+#: A vertex with no solid cell around it (a loose vertex in no face) gets
+#: this many times its straight distance to the bone.
+UNREACHABLE_PENALTY = 4.0
+#: Cells within this many steps of the surface or of a bone stay out of big
+#: blocks, so paths that bend around the surface or start at a bone keep
+#: full resolution.
+FINE_MARGIN_CELLS = 1
+
+_SOLID_CONNECTIVITY = np.ones((3, 3, 3), dtype=bool)
+
+
+def volumetric_geodesic_distances(
+    mesh: Mesh,
+    heads: np.ndarray,
+    tails: np.ndarray,
+    *,
+    resolution: int = DEFAULT_RESOLUTION,
+    grid: VoxelGrid | None = None,
+    progress: ProgressCallback | None = None,
+) -> np.ndarray:
+    """Shortest distance through the solid from each vertex to each bone.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    heads, tails : (b, 3) float64 arrays, bone segments in world space
+    resolution : int, cells along the longest side of the mesh's bounding
+        box (default 88), widened to cover bones near the mesh
+    grid : VoxelGrid, optional
+        A grid of this mesh already voxelised and filled (as returned by
+        :func:`fill_interior`), to share it between distance kinds;
+        ``resolution`` is then ignored.
+    progress : optional ProgressCallback
+
+    Returns
+    -------
+    (n, b) float64 array of distances in scene units, all finite.
+    """
+    heads, tails = validate_bones(heads, tails)
+    if grid is None:
+        grid = voxelize_surface(
+            mesh, resolution, cover_points=np.vstack([heads, tails]), progress=sub_progress(progress, 0.0, 0.15)
+        )
+        grid = fill_interior(grid)
+    report(progress, 0.2, "Building the path graph")
+    graph = build_geodesic_graph(grid, heads, tails)
+    candidates, query_nodes = vertex_cell_candidates(graph, mesh.vertices)
+    node_distances = bone_node_distances(graph, query_nodes, sub_progress(progress, 0.3, 0.95))
+    distances, _ = combine_vertex_distances(graph, mesh.vertices, candidates, query_nodes, node_distances)
+    distances = refine_in_sight(grid, grid.occupied, distances, mesh.vertices, heads, tails)
+    report(progress, 1.0, "Distances done")
+    return fill_unreached(distances, mesh.vertices, heads, tails, UNREACHABLE_PENALTY)
+
+
+def build_geodesic_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) -> BoneGraph:
+    """The path graph over the solid cells of a filled ``grid``.
+
+    Parameters
+    ----------
+    grid : VoxelGrid with ``inside`` filled
+    heads, tails : (b, 3) float64 arrays
+
+    Returns
+    -------
+    BoneGraph whose bone sources reach every solid part (see module docstring).
+    """
+    heads, tails = validate_bones(heads, tails)
+    solid = grid.occupied
+    fine = dilate(grid.surface | bone_mask(grid, heads, tails), FINE_MARGIN_CELLS)
+    nodes = merge_cells(grid, np.where(solid, 0, -1), grid.inside & ~fine)
+    pairs = neighbour_node_pairs(nodes)
+
+    bone, cells = segment_cells(grid, heads, tails)
+    in_solid = solid[cells[:, 0], cells[:, 1], cells[:, 2]]
+    bone, cells = bone[in_solid], cells[in_solid]
+    node = nodes.cell_node[cells[:, 0], cells[:, 1], cells[:, 2]]
+    length = paired_point_segment_distances(nodes.centres[node], heads[bone], tails[bone])
+
+    jump_bone, jump_node, jump_length = _jumps_to_uncrossed_parts(grid, nodes, heads, tails, bone, node)
+    sources = (
+        np.concatenate([bone, jump_bone]),
+        np.concatenate([node, jump_node]),
+        np.concatenate([length, jump_length]),
+    )
+    return assemble_bone_graph(grid, nodes, pairs, None, 0.0, sources, len(heads))
+
+
+def _jumps_to_uncrossed_parts(grid, nodes, heads, tails, source_bone, source_node):
+    """Edges from each bone to every solid part (26-connected component) it
+    does not cross, entering at the part's surface cell nearest the bone.
+
+    The edge costs :data:`OUTSIDE_JUMP_PENALTY` times the jump from the bone
+    to that cell's centre, plus the step from the cell to its node's centre
+    (only the air is penalised).
+
+    Returns
+    -------
+    bone, node : (j,) int64 arrays; length : (j,) float64 edge lengths
+    """
+    solid = grid.occupied
+    labels, part_count = ndimage.label(solid, structure=_SOLID_CONNECTIVITY)
+    node_part = np.zeros(nodes.count, dtype=np.int64)
+    node_part[nodes.cell_node[solid]] = labels[solid] - 1
+    bone_count = len(heads)
+    crossed = np.zeros((part_count, bone_count), dtype=bool)
+    crossed[node_part[source_node], source_bone] = True
+    if crossed.all():
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    # The nearest solid cell to a point outside a part is on its surface.
+    cells = np.argwhere(grid.surface)
+    cell_part = labels[grid.surface] - 1
+    order = np.argsort(cell_part, kind="stable")
+    cells, cell_part = cells[order], cell_part[order]
+    bounds = np.searchsorted(cell_part, np.arange(part_count + 1))
+    jump_bone, jump_node, jump_length = [], [], []
+    for part in np.flatnonzero(~crossed.all(axis=1)):
+        members = cells[bounds[part] : bounds[part + 1]]
+        if not len(members):
+            continue
+        bones = np.flatnonzero(~crossed[part])
+        centres = grid.cell_centres(members)
+        distances = point_segment_distances(centres, heads[bones], tails[bones])
+        nearest = distances.argmin(axis=0)
+        entry = members[nearest]
+        node = nodes.cell_node[entry[:, 0], entry[:, 1], entry[:, 2]]
+        to_node = np.linalg.norm(nodes.centres[node] - centres[nearest], axis=1)
+        jump_bone.append(bones)
+        jump_node.append(node)
+        jump_length.append(OUTSIDE_JUMP_PENALTY * distances[nearest, np.arange(len(bones))] + to_node)
+    if not jump_bone:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(jump_bone), np.concatenate(jump_node), np.concatenate(jump_length)

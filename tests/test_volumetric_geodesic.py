@@ -1,0 +1,121 @@
+"""Volumetric geodesic vertex-to-bone distances on shapes with known answers."""
+
+import numpy as np
+import pytest
+from geometry_fixtures import cylinder
+from test_voxelize import box_mesh
+
+from autorig_addon.core.errors import Cancelled, InputError
+from autorig_addon.core.types import Mesh
+from autorig_addon.core.volumetric_geodesic import (
+    OUTSIDE_JUMP_PENALTY,
+    UNREACHABLE_PENALTY,
+    volumetric_geodesic_distances,
+)
+from autorig_addon.core.voxelize import point_segment_distances
+
+
+def vertex_index(mesh: Mesh, point) -> int:
+    index = int(np.argmin(np.linalg.norm(mesh.vertices - np.asarray(point, float), axis=1)))
+    assert np.allclose(mesh.vertices[index], point), "the fixture has no vertex there"
+    return index
+
+
+def u_tube() -> Mesh:
+    """Two upright arms (x in [0, 0.2] and [0.8, 1], y in [0, 1]) joined by
+    a base (y in [0, 0.2]); 0.2 thick in z. Three overlapping closed boxes."""
+    return Mesh.concatenate([
+        box_mesh([0, 0, 0], [0.2, 1, 0.2], 0.05),
+        box_mesh([0, 0, 0], [1, 0.2, 0.2], 0.05),
+        box_mesh([0.8, 0, 0], [1, 1, 0.2], 0.05),
+    ])
+
+
+def test_convex_shape_gives_straight_distances():
+    mesh = cylinder(radius=0.2, height=2.0, segments=32, rings=41)
+    heads, tails = np.array([[0, 0, 0.0], [0, 0, 1.0]]), np.array([[0, 0, 1.0], [0, 0, 2.0]])
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=88)
+    # Inside a convex solid every bone is in sight: the geodesic is the straight line.
+    np.testing.assert_allclose(distances, point_segment_distances(mesh.vertices, heads, tails), atol=1e-9)
+
+
+def test_bent_tube_geodesic_goes_around_the_bend():
+    mesh = u_tube()
+    heads = np.array([[0.1, 0.3, 0.1], [0.9, 0.3, 0.1]])  # one bone up each arm
+    tails = np.array([[0.1, 1.0, 0.1], [0.9, 1.0, 0.1]])
+    resolution = 88
+    cell = 1.0 / resolution
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=resolution)
+    tip = vertex_index(mesh, [0.2, 1.0, 0.1])  # top of the first arm, inner face
+    straight = point_segment_distances(mesh.vertices[[tip]], heads, tails)[0]
+    assert straight[1] == pytest.approx(0.7)
+    # Down the inner face (0.8), across the base (0.6), up 45 degrees to the
+    # bone's lower end (0.1 * sqrt 2).
+    expected = 0.8 + 0.6 + 0.1 * np.sqrt(2)
+    assert distances[tip, 1] == pytest.approx(expected, abs=1.5 * cell)
+    assert distances[tip, 1] - straight[1] > 0.8
+    # Its own bone is in sight: straight distance, exactly.
+    assert distances[tip, 0] == pytest.approx(straight[0], abs=1e-9)
+
+
+def test_bone_outside_the_mesh_gets_finite_penalised_distances():
+    mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.1)
+    heads, tails = np.array([[0.5, 0.5, 1.3]]), np.array([[0.5, 0.5, 1.6]])
+    cell = 1.25 / 88  # the grid grows to cover the bone, by at most a quarter of the box
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=88)
+    assert np.all(np.isfinite(distances))
+    top = vertex_index(mesh, [0.5, 0.5, 1.0])
+    bottom = vertex_index(mesh, [0.5, 0.5, 0.0])
+    # A penalised jump across the 0.3 gap, then straight down through the box.
+    assert distances[top, 0] == pytest.approx(OUTSIDE_JUMP_PENALTY * 0.3, abs=3 * cell)
+    assert distances[bottom, 0] == pytest.approx(OUTSIDE_JUMP_PENALTY * 0.3 + 1.0, abs=3 * cell)
+
+
+def test_disconnected_part_is_reached_from_the_nearest_bone():
+    body = cylinder(radius=0.2, height=1.0, segments=32, rings=21)
+    hat = box_mesh([-0.15, -0.15, 1.1], [0.15, 0.15, 1.3], 0.05)
+    mesh = Mesh.concatenate([body, hat])
+    heads = np.array([[0, 0, 0.05], [0, 0, 0.6]])
+    tails = np.array([[0, 0, 0.6], [0, 0, 0.95]])
+    cell = 1.3 / 88
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=88)
+    assert np.all(np.isfinite(distances))
+    hat_vertices = np.arange(body.vertex_count, mesh.vertex_count)
+    straight = point_segment_distances(mesh.vertices, heads, tails)
+    assert np.all(distances[hat_vertices] > straight[hat_vertices])
+    assert np.all(distances[hat_vertices, 1] < distances[hat_vertices, 0])
+    # From the upper bone's tip across the 0.15 air gap, penalised.
+    brim_centre = vertex_index(mesh, [0, 0, 1.1])
+    assert distances[brim_centre, 1] == pytest.approx(OUTSIDE_JUMP_PENALTY * 0.15, abs=3 * cell)
+
+
+def test_vertex_in_no_face_gets_the_documented_fallback():
+    body = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
+    stray = np.array([[5.0, 0.5, 0.5]])
+    mesh = Mesh(np.vstack([body.vertices, stray]), body.triangles)
+    heads, tails = np.array([[0.5, 0.5, 0.2]]), np.array([[0.5, 0.5, 0.8]])
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=20)
+    expected = UNREACHABLE_PENALTY * point_segment_distances(stray, heads, tails)[0, 0]
+    assert distances[-1, 0] == pytest.approx(expected)
+
+
+def test_progress_is_reported_and_cancel_stops_the_work():
+    mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
+    heads, tails = np.array([[0.5, 0.5, 0.2]]), np.array([[0.5, 0.5, 0.8]])
+    fractions = []
+    volumetric_geodesic_distances(mesh, heads, tails, resolution=16, progress=lambda f, m: fractions.append(f))
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+
+    def cancel(fraction, message):
+        raise Cancelled()
+
+    with pytest.raises(Cancelled):
+        volumetric_geodesic_distances(mesh, heads, tails, resolution=16, progress=cancel)
+
+
+def test_bad_bones_are_rejected():
+    mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
+    with pytest.raises(InputError, match="No bones"):
+        volumetric_geodesic_distances(mesh, np.zeros((0, 3)), np.zeros((0, 3)))
+    with pytest.raises(InputError, match="NaN"):
+        volumetric_geodesic_distances(mesh, [[np.nan, 0, 0]], [[0, 0, 1]])
