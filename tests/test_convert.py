@@ -296,3 +296,22 @@ def test_read_weights_of_a_bound_mesh_after_write(clean_scene):
     bpy.context.view_layer.update()
     assert convert.find_armature(box) == armature
     np.testing.assert_array_equal(convert.read_weights(box, [LOWER_BONE, UPPER_BONE]).matrix, [[1.0, 0.0]] * 8)
+
+
+def test_read_mesh_gives_the_rest_shape_of_a_posed_skinned_mesh(clean_scene):
+    import bpy
+    from mathutils import Quaternion
+
+    from autorig_addon.blender.convert import read_mesh
+    from blender_fixtures import build_rig_scene, local_positions
+
+    scene = build_rig_scene(with_button=False)
+    rest = local_positions(scene.body) @ np.array(scene.body.matrix_world)[:3, :3].T + np.array(scene.body.matrix_world)[:3, 3]
+    bone = scene.armature.pose.bones["Upper"]
+    bone.rotation_mode = "QUATERNION"
+    bone.rotation_quaternion = Quaternion((1, 0, 0), 1.0)
+    bpy.context.view_layer.update()
+    mesh = read_mesh([scene.body], bpy.context.evaluated_depsgraph_get())
+    np.testing.assert_allclose(mesh.vertices, rest, atol=1e-5)
+    assert scene.armature.data.pose_position == "POSE"  # restored
+    assert bone.rotation_quaternion.angle > 0.9

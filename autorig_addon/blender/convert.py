@@ -11,6 +11,7 @@ Every writer here is all-or-nothing: it snapshots what it is about to touch
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Iterable, Sequence
 
@@ -132,8 +133,9 @@ def read_mesh(objects, depsgraph=None) -> Mesh:
         results map back 1:1.
     depsgraph : bpy.types.Depsgraph or None
         Used to read modifier-deformed geometry where the modifiers keep the
-        vertex count (the original mesh is read otherwise). ``None`` reads
-        the current context's evaluated depsgraph.
+        vertex count (the original mesh is read otherwise), with every
+        armature deforming the objects in Rest Position. ``None`` reads the
+        current context's evaluated depsgraph.
 
     Returns
     -------
@@ -146,9 +148,35 @@ def read_mesh(objects, depsgraph=None) -> Mesh:
     object_list = _as_object_list(objects)
     if not object_list:
         raise InputError("No mesh objects given.")
-    if depsgraph is None:
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-    return Mesh.concatenate([_read_one_mesh(obj, depsgraph) for obj in object_list])
+    with armatures_at_rest(object_list):
+        if depsgraph is None:
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        return Mesh.concatenate([_read_one_mesh(obj, depsgraph) for obj in object_list])
+
+
+@contextmanager
+def armatures_at_rest(objects):
+    """Put the armatures deforming ``objects`` in Rest Position while the
+    block runs: weights belong to the rest shape, and some files (CesiumMan)
+    import posed. The pose setting is restored afterwards."""
+    armatures = {
+        modifier.object
+        for obj in objects if obj is not None and obj.type == "MESH"
+        for modifier in obj.modifiers
+        if modifier.type == "ARMATURE" and modifier.object is not None
+    }
+    posed = [armature for armature in armatures if armature.data.pose_position != "REST"]
+    for armature in posed:
+        armature.data.pose_position = "REST"
+    try:
+        if posed:
+            bpy.context.view_layer.update()
+        yield
+    finally:
+        for armature in posed:
+            armature.data.pose_position = "POSE"
+        if posed:
+            bpy.context.view_layer.update()
 
 
 def _parents_first_order(parent_of: Sequence[int]) -> list[int]:
