@@ -351,12 +351,12 @@ def _add_skin_arguments(parser: argparse.ArgumentParser) -> None:
                         help="geodesic: through the inside of the mesh (RigNet); hollow: HollowDist through empty "
                              "space, reaches bones outside the body and loose parts (HeterSkinNet)")
     parser.add_argument("--resolution", type=int, default=88, help="Voxels along the longest side (default 88)")
-    parser.add_argument("--falloff", type=_positive, default=2.0,
-                        help="Exponent of the distance falloff (default 2)")
+    parser.add_argument("--falloff", type=_positive, default=4.0,
+                        help="Heat strength: higher gives sharper blends between bones (default 4)")
     parser.add_argument("--max-influences", type=_non_negative_int, default=4,
                         help="Bones per vertex to keep, 0 = no limit (default 4)")
-    parser.add_argument("--smoothing-iterations", type=_non_negative_int, default=2,
-                        help="Surface smoothing passes (default 2)")
+    parser.add_argument("--smoothing-iterations", type=_non_negative_int, default=0,
+                        help="Extra surface smoothing passes (default 0)")
     parser.add_argument("--smoothing-strength", type=_fraction, default=0.5,
                         help="Blend factor of one smoothing pass, 0 to 1 (default 0.5)")
     parser.add_argument("--replace-all", action="store_true",

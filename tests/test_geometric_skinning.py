@@ -7,9 +7,8 @@ from test_voxelize import box_mesh
 
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.geometric_skinning import (
-    FAR_SCALE_FACTOR,
-    falloff_weights,
     geometric_weights,
+    heat_diffusion_weights,
     smooth_over_surface,
 )
 from autorig_addon.core.mesh_ops import weld_vertices
@@ -91,27 +90,32 @@ def test_only_deform_bones_get_columns():
     assert weights.matrix[mesh.vertices[:, 2] > 1.7, 1].min() > 0.95
 
 
-def test_given_distances_follow_the_documented_falloff():
-    # Three vertices of one triangle, no smoothing: weights are exactly
-    # (1 + (d - d_min) / s) ** -falloff, normalised.
-    mesh = Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
-    skeleton = Skeleton([[0, 0, 0], [1, 0, 0]], [-1, 0], ("a", "b"), [[1, 0, 0], [2, 0, 0]])
-    distances = np.array([[0.1, 0.3], [0.2, 0.2], [0.4, 0.1]])
-    weights = geometric_weights(mesh, skeleton, distances=distances, falloff=2.0, smoothing_iterations=0)
-    # d_min = 0.1, 0.2, 0.1; median 0.1, cap FAR_SCALE_FACTOR * 0.1 = 0.2 >= every d_min.
-    assert FAR_SCALE_FACTOR * 0.1 >= 0.2
-    raw = np.array([[1.0, (1 + 0.2 / 0.1) ** -2], [1.0, 1.0], [(1 + 0.3 / 0.1) ** -2, 1.0]])
-    np.testing.assert_allclose(weights.matrix, raw / raw.sum(axis=1, keepdims=True))
+def test_parts_whose_nearest_bone_is_one_bone_get_exactly_that_bone():
+    # Two separate triangles, each nearest to a different bone: the heat
+    # equation's solution is the indicator of the nearest bone on each part.
+    mesh = Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 0, 0], [6, 0, 0], [5, 1, 0]], [[0, 1, 2], [3, 4, 5]])
+    distances = np.array([[0.1, 0.9], [0.2, 0.8], [0.3, 0.7], [0.9, 0.1], [0.8, 0.2], [0.7, 0.3]])
+    weights = heat_diffusion_weights(mesh, distances, 4.0)
+    np.testing.assert_allclose(weights / weights.sum(axis=1, keepdims=True), [[1, 0]] * 3 + [[0, 1]] * 3, atol=1e-12)
 
 
-def test_falloff_caps_the_scale_far_from_the_bones():
-    # One near vertex (d_min 0.1) and one 10 away: the far one's scale is
-    # capped at FAR_SCALE_FACTOR times the median nearest distance.
-    distances = np.array([[0.1, 0.3], [0.1, 0.4], [10.0, 10.5]])
-    weights = falloff_weights(distances, 4.0, 1e-6)
-    cap = FAR_SCALE_FACTOR * 0.1
-    assert weights[2, 1] == pytest.approx((1 + 0.5 / cap) ** -4)
-    assert weights[0, 1] == pytest.approx((0.3 / 0.1) ** -4)
+def test_higher_falloff_gives_a_narrower_blend():
+    mesh, skeleton = two_bone_cylinder()
+
+    def blended_vertices(falloff):
+        upper = geometric_weights(mesh, skeleton, falloff=falloff).matrix[:, 1]
+        return np.count_nonzero((upper > 0.05) & (upper < 0.95))
+
+    assert blended_vertices(16.0) < blended_vertices(4.0) < blended_vertices(1.0)
+
+
+def test_weights_do_not_depend_on_scene_scale():
+    mesh, skeleton = two_bone_cylinder()
+    reference = geometric_weights(mesh, skeleton)
+    for scale in (1e-3, 1e3):
+        scaled_mesh = Mesh(mesh.vertices * scale, mesh.triangles)
+        scaled = Skeleton(skeleton.joints * scale, skeleton.parents, skeleton.names, skeleton.tails * scale)
+        np.testing.assert_allclose(geometric_weights(scaled_mesh, scaled).matrix, reference.matrix, atol=1e-6)
 
 
 def test_smoothing_averages_neighbours_and_keeps_loose_vertices():

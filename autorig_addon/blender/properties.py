@@ -138,14 +138,13 @@ class TransferOptionProperties:
 TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
 
 
-#: Default voxels along the longest side for skinning distances (both papers: 88).
-DEFAULT_SKIN_RESOLUTION = 88
-#: Default exponent of the distance falloff of geometric skinning.
-DEFAULT_SKIN_FALLOFF = 2.0
-#: Default bones per vertex after skinning.
-DEFAULT_SKIN_MAX_INFLUENCES = 4
-#: Default surface smoothing passes after skinning.
-DEFAULT_SKIN_SMOOTHING_ITERATIONS = 2
+
+from ..core.geometric_skinning import (  # noqa: E402  (defaults shared with the core)
+    DEFAULT_FALLOFF,
+    DEFAULT_MAX_INFLUENCES,
+    DEFAULT_SMOOTHING_ITERATIONS,
+)
+from ..core.voxelize import DEFAULT_RESOLUTION  # noqa: E402
 
 SKIN_DISTANCE_ITEMS = (
     ("GEODESIC", "Volumetric Geodesic",
@@ -165,20 +164,21 @@ class SkinOptionProperties:
     skin_resolution: IntProperty(
         name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "
         "(fingers, cloth) better and costs more time and memory",
-        min=16, max=512, soft_max=256, default=DEFAULT_SKIN_RESOLUTION,
+        min=16, max=512, soft_max=256, default=DEFAULT_RESOLUTION,
     )
     skin_falloff: FloatProperty(
-        name="Falloff", description="Exponent of how fast a bone's influence falls with distance "
-        "(weight ~ 1 / distance^falloff); higher gives sharper joints",
-        min=0.5, max=8.0, default=DEFAULT_SKIN_FALLOFF,
+        name="Falloff", description="Heat strength: how fast a bone's influence falls off away from the "
+        "surface it is nearest to (unitless); higher gives sharper joints, lower softer blends",
+        min=0.1, max=64.0, soft_max=16.0, default=DEFAULT_FALLOFF,
     )
     skin_max_influences: IntProperty(
         name="Max Influences", description="Bones per vertex to keep (0 = no limit; 4 for most game engines)",
-        min=0, max=MAX_INFLUENCES_LIMIT, default=DEFAULT_SKIN_MAX_INFLUENCES,
+        min=0, max=MAX_INFLUENCES_LIMIT, default=DEFAULT_MAX_INFLUENCES,
     )
     skin_smoothing_iterations: IntProperty(
-        name="Smoothing", description="Laplacian smoothing passes of the weights over the surface",
-        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SKIN_SMOOTHING_ITERATIONS,
+        name="Smoothing", description="Extra smoothing passes of the weights over the surface "
+        "(the heat diffusion is already smooth)",
+        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SMOOTHING_ITERATIONS,
     )
     skin_smoothing_strength: FloatProperty(
         name="Smoothing Strength", description="Blend factor of one smoothing pass",
