@@ -347,9 +347,9 @@ def _add_skin_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Mesh to skin (repeat, or comma-separate; default: every mesh except bone shapes)")
     parser.add_argument("--method", choices=("geometric",), default="geometric",
                         help="Skinning method (default geometric: falloff of voxel distances)")
-    parser.add_argument("--distance", choices=("geodesic", "hollow"), default="geodesic",
-                        help="geodesic: through the inside of the mesh (RigNet); hollow: HollowDist through empty "
-                             "space, reaches bones outside the body and loose parts (HeterSkinNet)")
+    parser.add_argument("--distance", choices=("geodesic", "hollow"), default="hollow",
+                        help="hollow (default): HollowDist through empty space, reaches bones outside the body and "
+                             "loose parts (HeterSkinNet); geodesic: through the inside of the mesh (RigNet)")
     parser.add_argument("--resolution", type=int, default=88, help="Voxels along the longest side (default 88)")
     parser.add_argument("--falloff", type=_positive, default=4.0,
                         help="Heat strength: higher gives sharper blends between bones (default 4)")

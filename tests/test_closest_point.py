@@ -1,5 +1,4 @@
 import numpy as np
-import pytest
 
 from autorig_addon.core.closest_point import TriangleMeshQuery, closest_points_on_triangles
 from geometry_fixtures import cylinder, grid

@@ -162,3 +162,21 @@ def test_bad_input_is_rejected_with_a_clear_message():
         geometric_weights(mesh, skeleton, max_influences=-1)
     with pytest.raises(InputError, match="Smoothing strength"):
         geometric_weights(mesh, skeleton, smoothing_strength=1.5)
+
+
+def test_a_vertex_sees_its_nearest_bone_only_when_the_path_is_straight():
+    from autorig_addon.core.geometric_skinning import sees_nearest_bone
+
+    vertices = np.array([[0.0, 1.0, 0.0], [0.0, 2.0, 0.0]])
+    heads, tails = np.array([[-1.0, 0.0, 0.0]]), np.array([[1.0, 0.0, 0.0]])
+    # Straight distances are 1 and 2; the second vertex's path bends around something (2.5).
+    distances = np.array([[1.0], [2.5]])
+    np.testing.assert_array_equal(sees_nearest_bone(vertices, distances, heads, tails), [True, False])
+
+
+def test_a_part_that_sees_no_bone_is_still_bound_to_its_nearest():
+    mesh = Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 0, 0], [6, 0, 0], [5, 1, 0]], [[0, 1, 2], [3, 4, 5]])
+    distances = np.array([[0.1, 0.9], [0.2, 0.8], [0.3, 0.7], [0.9, 0.1], [0.8, 0.2], [0.7, 0.3]])
+    heated = np.array([True, True, True, False, False, False])
+    weights = heat_diffusion_weights(mesh, distances, 4.0, heated)
+    np.testing.assert_allclose(weights / weights.sum(axis=1, keepdims=True), [[1, 0]] * 3 + [[0, 1]] * 3, atol=1e-12)

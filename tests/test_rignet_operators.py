@@ -8,8 +8,6 @@ from blender_fixtures import build_rig_scene, group_weights, select_only
 
 
 def test_build_armature_reproduces_skeleton_in_world_space(clean_scene):
-    import bpy
-
     from autorig_addon.blender.armature_builder import build_armature
     from autorig_addon.blender.convert import read_skeleton
 

@@ -1,6 +1,5 @@
 """The Skin operator and the ``skin`` subcommand on a generated 2-bone cylinder."""
 
-import json
 
 import numpy as np
 import pytest

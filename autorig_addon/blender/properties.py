@@ -141,6 +141,7 @@ TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
 
 from ..core.geometric_skinning import (  # noqa: E402  (defaults shared with the core)
     DEFAULT_FALLOFF,
+    DEFAULT_METHOD,
     DEFAULT_MAX_INFLUENCES,
     DEFAULT_SMOOTHING_ITERATIONS,
 )
@@ -159,7 +160,7 @@ class SkinOptionProperties:
 
     skin_distance: EnumProperty(
         name="Distance", description="How the distance from a vertex to a bone is measured",
-        items=SKIN_DISTANCE_ITEMS, default="GEODESIC",
+        items=SKIN_DISTANCE_ITEMS, default=DEFAULT_METHOD.upper(),
     )
     skin_resolution: IntProperty(
         name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "

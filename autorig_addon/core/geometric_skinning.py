@@ -16,8 +16,13 @@ Steps:
 2. Heat sources: each vertex's nearest bone ``j*`` (ties within
    :data:`NEAREST_TIE_FRACTION` share) heats it with strength
    ``H = falloff / d_min^2``, ``d_min`` its distance to that bone in units
-   of the mesh diagonal: close to a bone the surface is held to it, far away
-   the heat is weak and the surface takes what its neighbours have.
+   of the mesh diagonal, when the vertex *sees* that bone: its distance
+   through the shape equals the straight one (as bone heat's visibility
+   test, but read off the distances, so it never fails). Close to a bone the
+   surface is held to it; far away, or behind another part, the heat is
+   weak or absent and the surface takes what its neighbours have. A
+   connected part that sees no bone at all is heated everywhere, so every
+   part is bound.
 3. Diffusion over the surface: for every bone ``j`` solve
    ``(-L + M H) w_j = M H p_j`` (cotangent Laplacian ``L``, lumped mass
    ``M``, ``p_j`` the indicator of vertices whose nearest bone is ``j``) on
@@ -42,18 +47,19 @@ from scipy.sparse.linalg import splu
 
 from .errors import InputError
 from .hollow_dist import hollow_distances
-from .mesh_ops import adjacency_matrix, cotangent_laplacian, voronoi_mass, weld_vertices
+from .mesh_ops import adjacency_matrix, connected_component_labels, cotangent_laplacian, voronoi_mass, weld_vertices
 from .progress import ProgressCallback, report, sub_progress
 from .types import Mesh, Skeleton, Weights
 from .volumetric_geodesic import volumetric_geodesic_distances
-from .voxelize import DEFAULT_RESOLUTION
+from .voxelize import DEFAULT_RESOLUTION, paired_point_segment_distances
 from .weights import empty_rows, limit_influences, prune_small
 
 #: Distance kinds: "geodesic" (through the solid; needs closed parts for an
 #: interior, else paths follow the surface) and "hollow" (HollowDist,
 #: through the space the mesh leaves empty; no watertightness needed).
 METHODS = ("geodesic", "hollow")
-DEFAULT_METHOD = "geodesic"
+#: HollowDist: best on the training characters (see docs/skinning.md).
+DEFAULT_METHOD = "hollow"
 #: Heat strength (Baran & Popovic's c, unitless): how fast a bone's
 #: influence falls off away from the vertices it is nearest to. Higher gives
 #: sharper transitions between bones. 4 was best on the training characters
@@ -71,6 +77,9 @@ NEAREST_TIE_FRACTION = 1e-3
 #: Distances are floored at this fraction of the mesh's bounding-box
 #: diagonal, so a vertex lying on a bone does not divide by zero.
 DISTANCE_FLOOR_FRACTION = 1e-4
+#: A vertex sees its nearest bone when its distance through the shape is at
+#: most this much (relative) longer than the straight distance.
+VISIBILITY_SLACK = 0.02
 #: Vertices closer than this fraction of the diagonal are welded for the diffusion.
 WELD_FRACTION = 1e-6
 
@@ -125,7 +134,7 @@ def geometric_weights(
     else:
         distances = _checked_distances(distances, mesh.vertex_count, len(deform))
     report(progress, 0.9, "Diffusing bone heat")
-    weights = heat_diffusion_weights(mesh, distances, falloff)
+    weights = heat_diffusion_weights(mesh, distances, falloff, sees_nearest_bone(mesh.vertices, distances, heads, tails))
     weights = smooth_over_surface(weights, mesh, smoothing_iterations, smoothing_strength)
     weights = prune_small(limit_influences(weights, max_influences))
     weights = _nearest_bone_where_empty(weights, distances)
@@ -133,7 +142,24 @@ def geometric_weights(
     return Weights(weights, names)
 
 
-def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float) -> np.ndarray:
+def sees_nearest_bone(vertices: np.ndarray, distances: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
+    """(n,) bool: vertices whose distance to their nearest bone is the
+    straight-line one (within :data:`VISIBILITY_SLACK`), i.e. nothing of the
+    shape stands between them and the bone.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64 array
+    distances : (n, b) float64 array, through-the-shape distances
+    heads, tails : (b, 3) float64 arrays, the bones of ``distances``' columns
+    """
+    rows = np.arange(len(vertices))
+    nearest = distances.argmin(axis=1)
+    straight = paired_point_segment_distances(vertices, heads[nearest], tails[nearest])
+    return distances[rows, nearest] <= straight * (1.0 + VISIBILITY_SLACK) + 1e-12
+
+
+def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, heated: np.ndarray | None = None) -> np.ndarray:
     """Unnormalised weights: bone heat diffused over the surface (steps 2-3
     of the module docstring).
 
@@ -142,6 +168,8 @@ def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float) ->
     mesh : Mesh with n vertices (any scale; it is normalised to unit diagonal)
     distances : (n, b) float64 array, finite, >= 0, scene units
     falloff : float > 0, the heat strength
+    heated : (n,) bool array, vertices their nearest bone heats (default all);
+        parts with no heated vertex are heated everywhere
 
     Returns
     -------
@@ -163,6 +191,13 @@ def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float) ->
     # simply keep their source row instead of making the system singular.
     mass = np.maximum(mass, 1e-12 * max(mass.max(initial=0.0), 1e-300))
     heat = mass * float(falloff) / nearest**2
+    if heated is not None:
+        welded_heated = np.zeros(count, dtype=bool)
+        welded_heated[to_welded[np.asarray(heated, dtype=bool)]] = True
+        labels = connected_component_labels(welded_F, count)
+        part_heated = np.zeros(labels.max() + 1, dtype=bool)
+        part_heated[labels[welded_heated]] = True
+        heat = np.where(welded_heated | ~part_heated[labels], heat, 0.0)
     system = (-cotangent_laplacian(unit_V, welded_F) + sp.diags(heat)).tocsc()
     weights = splu(system, permc_spec="MMD_AT_PLUS_A").solve(np.asfortranarray(heat[:, None] * sources))
     return np.maximum(weights, 0.0)[to_welded]

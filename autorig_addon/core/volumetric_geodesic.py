@@ -51,10 +51,8 @@ from .voxelize import (
     VoxelGrid,
     assemble_bone_graph,
     bone_mask,
-    bone_node_distances,
-    combine_vertex_distances,
+    covering_filled_grid,
     dilate,
-    fill_interior,
     fill_unreached,
     merge_cells,
     neighbour_node_pairs,
@@ -63,8 +61,7 @@ from .voxelize import (
     refine_in_sight,
     segment_cells,
     validate_bones,
-    vertex_cell_candidates,
-    voxelize_surface,
+    vertex_distances_on_graph,
 )
 
 #: A jump through the air from a bone to a solid part it does not cross
@@ -110,15 +107,10 @@ def volumetric_geodesic_distances(
     """
     heads, tails = validate_bones(heads, tails)
     if grid is None:
-        grid = voxelize_surface(
-            mesh, resolution, cover_points=np.vstack([heads, tails]), progress=sub_progress(progress, 0.0, 0.15)
-        )
-        grid = fill_interior(grid)
+        grid = covering_filled_grid(mesh, heads, tails, resolution, sub_progress(progress, 0.0, 0.2))
     report(progress, 0.2, "Building the path graph")
     graph = build_geodesic_graph(grid, heads, tails)
-    candidates, query_nodes = vertex_cell_candidates(graph, mesh.vertices)
-    node_distances = bone_node_distances(graph, query_nodes, sub_progress(progress, 0.3, 0.95))
-    distances, _ = combine_vertex_distances(graph, mesh.vertices, candidates, query_nodes, node_distances)
+    distances, _ = vertex_distances_on_graph(graph, mesh.vertices, sub_progress(progress, 0.3, 0.95))
     distances = refine_in_sight(grid, grid.occupied, distances, mesh.vertices, heads, tails)
     report(progress, 1.0, "Distances done")
     return fill_unreached(distances, mesh.vertices, heads, tails, UNREACHABLE_PENALTY)

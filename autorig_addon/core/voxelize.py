@@ -44,7 +44,7 @@ from scipy import ndimage
 from scipy.sparse.csgraph import dijkstra
 
 from .errors import InputError
-from .progress import ProgressCallback, report
+from .progress import ProgressCallback, report, sub_progress
 from .types import Mesh
 
 #: Cells along the longest side of the mesh bounding box (both RigNet and
@@ -887,3 +887,20 @@ def _walk_in_sight(
         start, direction, inverse, t = start[keep], direction[keep], inverse[keep], t[keep]
         stop, slope, pair, leaving = stop[keep], slope[keep], pair[keep], leaving[keep]
     return visible
+
+
+def covering_filled_grid(mesh: Mesh, heads: np.ndarray, tails: np.ndarray, resolution: int,
+                         progress: ProgressCallback | None = None) -> VoxelGrid:
+    """The mesh voxelised at ``resolution`` (grown to cover the bones) with its inside filled."""
+    grid = voxelize_surface(mesh, resolution, cover_points=np.vstack([heads, tails]),
+                            progress=sub_progress(progress, 0.0, 0.75))
+    return fill_interior(grid)
+
+
+def vertex_distances_on_graph(graph: "BoneGraph", vertices: np.ndarray,
+                              progress: ProgressCallback | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Shortest-path distances from every vertex to every bone of ``graph``,
+    through the vertex's candidate cells (see :func:`combine_vertex_distances`)."""
+    candidates, query_nodes = vertex_cell_candidates(graph, vertices)
+    node_distances = bone_node_distances(graph, query_nodes, progress)
+    return combine_vertex_distances(graph, vertices, candidates, query_nodes, node_distances)
