@@ -13,17 +13,16 @@ copied/inpainted status, and the weight of one bone as a heat map.
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 
-import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, REPO)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
-from mathutils import Quaternion, Vector  # noqa: E402
+from mathutils import Vector  # noqa: E402
 
 from autorig_addon.blender.convert import (  # noqa: E402
     deform_bone_names,
@@ -37,6 +36,7 @@ from autorig_addon.core.closest_point import TriangleMeshQuery  # noqa: E402
 from autorig_addon.core.transfer import transfer_weights  # noqa: E402
 from autorig_addon.core.types import Weights  # noqa: E402
 from autorig_addon.core.weights import normalize_rows  # noqa: E402
+from docs_render import duplicate, heat_colors, render, save_side_by_side, set_colors, set_pose, setup_render  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 #: Pose used for the comparison: (bone, axis, degrees) in the bone's local frame.
@@ -45,86 +45,11 @@ POSE = [
     ("upperleg01.R", "X", 30.0),
     ("lowerleg01.R", "X", 35.0),
 ]
-RESOLUTION = (260, 390)
 
 
 def closest_point_weights(source, source_weights: Weights, target) -> Weights:
     surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
     return Weights(normalize_rows(surface.interpolate(source.triangles, source_weights.matrix)), source_weights.bone_names)
-
-
-def duplicate(obj, name: str):
-    copy = obj.copy()
-    copy.data = obj.data.copy()
-    copy.name = name
-    bpy.context.scene.collection.objects.link(copy)
-    return copy
-
-
-def set_pose(armature, pose) -> None:
-    for bone_name, axis, degrees in pose:
-        bone = armature.pose.bones.get(bone_name)
-        if bone is None:
-            continue
-        bone.rotation_mode = "QUATERNION"
-        vector = {"X": (1, 0, 0), "Y": (0, 1, 0), "Z": (0, 0, 1)}[axis]
-        bone.rotation_quaternion = Quaternion(vector, math.radians(degrees))
-    bpy.context.view_layer.update()
-
-
-def setup_render(scene, look_at: Vector, height: float) -> None:
-    scene.render.engine = "BLENDER_WORKBENCH"
-    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
-    scene.render.film_transparent = False
-    scene.display.shading.light = "STUDIO"
-    scene.display.shading.show_cavity = False
-    camera_data = bpy.data.cameras.new("DocsCamera")
-    camera_data.type = "ORTHO"
-    camera_data.ortho_scale = height * 1.1
-    camera = bpy.data.objects.new("DocsCamera", camera_data)
-    scene.collection.objects.link(camera)
-    direction = Vector((1.0, -0.8, 0.1)).normalized()
-    camera.location = look_at + direction * 6.0
-    camera.rotation_euler = (-direction).to_track_quat("-Z", "Y").to_euler()
-    scene.camera = camera
-
-
-def render(scene, visible, path: str, color_type: str) -> np.ndarray:
-    for obj in scene.objects:
-        obj.hide_render = obj.type == "MESH" and obj not in visible
-    scene.display.shading.color_type = color_type
-    scene.display.shading.single_color = (0.8, 0.8, 0.8)
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-    image = bpy.data.images.load(path)
-    pixels = np.array(image.pixels[:], dtype=np.float32).reshape(image.size[1], image.size[0], 4)
-    bpy.data.images.remove(image)
-    os.remove(path)
-    return pixels
-
-
-def save_side_by_side(panels, path: str) -> None:
-    strip = np.concatenate(panels, axis=1)
-    image = bpy.data.images.new("strip", strip.shape[1], strip.shape[0], alpha=True)
-    image.pixels.foreach_set(strip.ravel())
-    image.filepath_raw = path
-    image.file_format = "PNG"
-    image.save()
-    bpy.data.images.remove(image)
-    print("wrote", path)
-
-
-def heat_colors(values: np.ndarray) -> np.ndarray:
-    """(n, 4) blue (0) -> red (1) colours."""
-    t = np.clip(values, 0, 1)[:, None]
-    blue, red = np.array([0.05, 0.1, 0.9, 1.0]), np.array([0.95, 0.1, 0.05, 1.0])
-    return ((1 - t) * blue + t * red).astype(np.float32)
-
-
-def set_colors(obj, colors: np.ndarray, name: str = "Docs") -> None:
-    attribute = obj.data.color_attributes.new(name, "FLOAT_COLOR", "POINT")
-    attribute.data.foreach_set("color", colors.ravel())
-    obj.data.color_attributes.active_color_name = name
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,75 @@
+"""Render the pictures of docs/skinning.md (headless, Workbench engine).
+
+Usage (from the repo root)::
+
+    .venv/bin/python scripts/render_skinning_docs.py [--out docs/images] [CHARACTER.glb ...]
+
+For each character (default: four validation characters of data_split.json)
+renders, side by side, the artist's weights and the geometric method's, each
+bone in its own colour and vertices coloured by the weight-blended mix.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, REPO)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+from mathutils import Vector  # noqa: E402
+
+from autorig_addon.blender.characters import load_character  # noqa: E402
+from autorig_addon.core.geometric_skinning import geometric_weights  # noqa: E402
+from docs_render import bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render  # noqa: E402
+
+CHARACTERS = os.path.join(REPO, "..", "shared", "data", "characters")
+DEFAULT_CHARACTERS = (
+    "quaternius_glb/single_knight_pack/KnightCharacter.glb",
+    "quaternius_glb/animals_pack/Wolf.glb",
+    "quaternius_glb/dinosaurs_pack/Stegosaurus.glb",
+    "kaykit/Rogue_Hooded.glb",
+)
+
+
+def render_character(path: str, out_dir: str) -> None:
+    character = load_character(path)
+    deform = character.skeleton.deform_subset()
+    ours = geometric_weights(character.mesh, character.skeleton)
+    artist = character.weights.select_bones(deform.names).matrix
+    palette = bone_palette(len(deform.names))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    vertices = character.mesh.vertices
+    lo, hi = vertices.min(0), vertices.max(0)
+    setup_render(scene, Vector(((lo + hi) / 2).tolist()), float((hi - lo).max()), direction=(0.7, -1.0, 0.35))
+    panels = []
+    for label, weights in (("artist", artist), ("geometric", ours.select_bones(deform.names).matrix)):
+        obj = mesh_from_arrays(label, vertices, character.mesh.triangles)
+        colors = np.clip(weights @ palette, 0, 1)
+        colors[:, 3] = 1.0
+        set_colors(obj, colors)
+        panels.append(render(scene, [obj], os.path.join(out_dir, "_panel.png"), "VERTEX"))
+        bpy.data.objects.remove(obj)
+    name = os.path.splitext(os.path.basename(path))[0]
+    save_side_by_side(panels, os.path.join(out_dir, f"skinning_{name}.png"))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("characters", nargs="*", default=[os.path.join(CHARACTERS, c) for c in DEFAULT_CHARACTERS])
+    parser.add_argument("--out", default=os.path.join(REPO, "docs", "images"))
+    args = parser.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    for path in args.characters:
+        render_character(path, args.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
