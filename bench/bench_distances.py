@@ -26,7 +26,9 @@ import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, REPO)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from memory import peak_rss_added  # noqa: E402
 from autorig_addon.core.hollow_dist import build_hollow_graph, refine_hollow_in_sight  # noqa: E402
 from autorig_addon.core.types import Mesh, Skeleton  # noqa: E402
 from autorig_addon.core.volumetric_geodesic import build_geodesic_graph  # noqa: E402
@@ -179,19 +181,6 @@ def run_stages(mesh: Mesh, heads, tails, resolution: int, kind: str) -> dict[str
     times["nodes"] = graph.nodes.count
     times["cells"] = int(np.prod(grid.shape))
     return times
-
-
-def peak_rss_added(function) -> float:
-    """MiB of resident memory above the starting level at the peak of ``function()``."""
-    def rss(field):
-        with open("/proc/self/status") as status:
-            return next(int(line.split()[1]) for line in status if line.startswith(field)) / 1024.0
-
-    with open("/proc/self/clear_refs", "w") as clear:
-        clear.write("5")  # resets VmHWM to the current RSS
-    start = rss("VmRSS:")
-    function()
-    return rss("VmHWM:") - start
 
 
 def main(argv=None) -> int:

@@ -23,7 +23,9 @@ import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, REPO)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from memory import peak_rss_added  # noqa: E402
 from autorig_addon.core.closest_point import TriangleMeshQuery  # noqa: E402
 from autorig_addon.core.transfer import transfer_weights  # noqa: E402
 from autorig_addon.core.types import Weights  # noqa: E402
@@ -51,19 +53,6 @@ def closest_point_copy(source, source_weights: Weights, target) -> np.ndarray:
     """The baseline: every target vertex takes the weights at its closest source point."""
     surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
     return normalize_rows(surface.interpolate(source.triangles, source_weights.matrix))
-
-
-def peak_rss_added(function) -> float:
-    """MiB of resident memory above the starting level at the peak of ``function()``."""
-    def rss(field):
-        with open("/proc/self/status") as status:
-            return next(int(line.split()[1]) for line in status if line.startswith(field)) / 1024.0
-
-    with open("/proc/self/clear_refs", "w") as clear:
-        clear.write("5")  # resets VmHWM to the current RSS
-    start = rss("VmRSS:")
-    function()
-    return rss("VmHWM:") - start
 
 
 def main(argv=None) -> int:
