@@ -111,6 +111,9 @@ def test_seam_split_copies_get_the_same_weights_as_the_welded_mesh(body):
     soup = Mesh(soup_vertices, np.arange(len(soup_vertices)).reshape(-1, 3))
     split = transfer_weights(source, weights, soup, inpaint_mask=mask[target.triangles.ravel()])
     np.testing.assert_allclose(split.weights.matrix, welded.weights.matrix[target.triangles.ravel()], atol=1e-9)
+    assert welded.welded_vertices == 0
+    assert split.welded_vertices == soup.vertex_count - target.vertex_count
+    assert f"{split.welded_vertices} seam duplicates welded" in split.summary()
 
 
 def test_degenerate_target_triangles_never_produce_nan(body):
@@ -179,3 +182,16 @@ def test_huge_and_tiny_scenes_give_the_same_weights(body, scale):
                               Mesh(target.vertices * scale, target.triangles), inpaint_mask=mask)
     np.testing.assert_array_equal(scaled.status, reference.status)
     np.testing.assert_allclose(scaled.weights.matrix, reference.weights.matrix, atol=1e-7)
+
+
+def test_non_manifold_edge_is_handled_and_reported(body):
+    source, weights = body
+    target = sleeve()
+    a, b = target.triangles[0][:2]
+    fin_tip = (target.vertices[a] + target.vertices[b]) / 2 + np.array([0.0, 0.0, 0.02]) + 0.3 * target.vertices[a] * [1, 1, 0]
+    fin = Mesh(np.vstack([target.vertices, fin_tip]), np.vstack([target.triangles, [[a, b, target.vertex_count]]]))
+    result = transfer_weights(source, weights, fin)
+    assert result.non_manifold_edges == 1
+    assert "1 non-manifold edges" in result.summary()
+    assert np.all(np.isfinite(result.weights.matrix))
+    np.testing.assert_allclose(result.weights.matrix.sum(axis=1), 1.0, atol=1e-12)

@@ -34,6 +34,7 @@ from .mesh_ops import (
     adjacency_matrix,
     connected_component_labels,
     cotangent_laplacian,
+    non_manifold_edge_count,
     vertex_normals,
     voronoi_mass,
     weld_vertices,
@@ -108,12 +109,16 @@ class TransferResult:
     status : (n_target,) int8 array of :class:`VertexStatus`
     max_distance : float, the match distance used (scene units)
     timings : dict of stage name -> seconds
+    welded_vertices : int, seam copies joined to another vertex before inpainting
+    non_manifold_edges : int, edges shared by more than two triangles (handled, reported)
     """
 
     weights: Weights
     status: np.ndarray
     max_distance: float
     timings: dict = field(default_factory=dict)
+    welded_vertices: int = 0
+    non_manifold_edges: int = 0
 
     def summary(self) -> str:
         counts = np.bincount(self.status, minlength=len(VertexStatus))
@@ -125,6 +130,10 @@ class TransferResult:
             parts.append(f"{counts[VertexStatus.PROTECTED]} protected")
         if counts[VertexStatus.UNMATCHED_PART]:
             parts.append(f"{counts[VertexStatus.UNMATCHED_PART]} on parts with no match")
+        if self.welded_vertices:
+            parts.append(f"{self.welded_vertices} seam duplicates welded")
+        if self.non_manifold_edges:
+            parts.append(f"{self.non_manifold_edges} non-manifold edges")
         return ", ".join(parts)
 
 
@@ -331,7 +340,10 @@ def transfer_weights(
         weights[protected] = kept[protected]
     timings["finish"] = time.perf_counter() - clock
     report(progress, 1.0, "Done")
-    return TransferResult(Weights(weights, source_weights.bone_names), status[to_welded], float(max_distance), timings)
+    return TransferResult(
+        Weights(weights, source_weights.bone_names), status[to_welded], float(max_distance), timings,
+        welded_vertices=n - count, non_manifold_edges=non_manifold_edge_count(welded_F),
+    )
 
 
 def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: TransferOptions) -> None:
