@@ -232,6 +232,15 @@ def _positive(text: str) -> float:
     return value
 
 
+def _resolution(text: str) -> int:
+    from .core.voxelize import MAX_RESOLUTION, MIN_RESOLUTION
+
+    value = int(text)
+    if not MIN_RESOLUTION <= value <= MAX_RESOLUTION:
+        raise argparse.ArgumentTypeError(f"{text} is outside {MIN_RESOLUTION} to {MAX_RESOLUTION}")
+    return value
+
+
 def _non_negative_int(text: str) -> int:
     value = int(text)
     if value < 0:
@@ -345,12 +354,11 @@ def _add_skin_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--armature", default="", help="Armature to bind to (default: the only armature in the file)")
     parser.add_argument("--mesh", action="append", default=[], metavar="OBJ",
                         help="Mesh to skin (repeat, or comma-separate; default: every mesh except bone shapes)")
-    parser.add_argument("--method", choices=("geometric",), default="geometric",
-                        help="Skinning method (default geometric: falloff of voxel distances)")
     parser.add_argument("--distance", choices=("geodesic", "hollow"), default="hollow",
                         help="hollow (default): HollowDist through empty space, reaches bones outside the body and "
                              "loose parts (HeterSkinNet); geodesic: through the inside of the mesh (RigNet)")
-    parser.add_argument("--resolution", type=int, default=88, help="Voxels along the longest side (default 88)")
+    parser.add_argument("--resolution", type=_resolution, default=88,
+                        help="Voxels along the longest side (default 88, 4 to 1024)")
     parser.add_argument("--falloff", type=_positive, default=4.0,
                         help="Heat strength: higher gives sharper blends between bones (default 4)")
     parser.add_argument("--max-influences", type=_non_negative_int, default=4,

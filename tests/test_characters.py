@@ -130,7 +130,8 @@ def test_good_rig_deforms_to_itself(clean_scene, tmp_path, extension):
     check = characters.check_bind_pose(path)
     assert check.deforms_to_itself and check.rest_error < 1e-6
     assert check.reasons == ()
-    assert check.vertex_count == 506 or extension == ".glb"
+    # glTF export splits the 506 vertices along the fixture's flat-shaded edges.
+    assert check.vertex_count == {".blend": 506, ".glb": 1058}[extension]
     if extension == ".glb":
         assert check.pose_error < 1e-6
     else:

@@ -315,3 +315,18 @@ def test_read_mesh_gives_the_rest_shape_of_a_posed_skinned_mesh(clean_scene):
     np.testing.assert_allclose(mesh.vertices, rest, atol=1e-5)
     assert scene.armature.data.pose_position == "POSE"  # restored
     assert bone.rotation_quaternion.angle > 0.9
+
+
+def test_rebinding_to_another_armature_leaves_one_modifier_and_failure_restores_both(clean_scene):
+    from blender_fixtures import build_rig_scene, make_armature
+
+    scene = build_rig_scene(with_button=False)
+    other = make_armature("Other")
+    extra = scene.body.modifiers.new("Second", "ARMATURE")
+    extra.object = scene.armature
+    before = [(m.name, m.object.name) for m in scene.body.modifiers]
+    snapshot = convert.ObjectSnapshot.capture(scene.body)
+    convert.ensure_armature_binding(scene.body, other)
+    assert [(m.type, m.object.name) for m in scene.body.modifiers] == [("ARMATURE", "Other")]
+    snapshot.restore()
+    assert [(m.name, m.object.name) for m in scene.body.modifiers] == before

@@ -9,9 +9,8 @@ from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.geometric_skinning import (
     geometric_weights,
     heat_diffusion_weights,
-    smooth_over_surface,
 )
-from autorig_addon.core.mesh_ops import weld_vertices
+from autorig_addon.core.mesh_ops import smooth_over_edges, weld_vertices
 from autorig_addon.core.types import Mesh, Skeleton
 
 
@@ -121,7 +120,7 @@ def test_weights_do_not_depend_on_scene_scale():
 def test_smoothing_averages_neighbours_and_keeps_loose_vertices():
     mesh = Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]], [[0, 1, 2]])
     values = np.array([[1.0], [0.0], [0.0], [7.0]])
-    smoothed = smooth_over_surface(values, mesh, iterations=1, strength=0.5)
+    smoothed = smooth_over_edges(values, mesh.triangles, iterations=1, strength=0.5)
     np.testing.assert_allclose(smoothed.ravel(), [0.5, 0.25, 0.25, 7.0])
 
 
@@ -132,7 +131,7 @@ def test_welded_mesh_smoothing_spreads_across_the_whole_surface():
     welded = Mesh(welded_vertices, welded_triangles)
     values = np.zeros((welded.vertex_count, 1))
     values[0] = 1.0
-    smoothed = smooth_over_surface(values, welded, iterations=20, strength=0.5)
+    smoothed = smooth_over_edges(values, welded.triangles, iterations=20, strength=0.5)
     assert np.all(smoothed > 0)
 
 

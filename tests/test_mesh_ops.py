@@ -79,3 +79,15 @@ def test_vertex_normals_of_closed_cylinder_point_outwards():
     cosine = np.einsum("ij,ij->i", N[side], radial / np.linalg.norm(radial, axis=1, keepdims=True))
     assert cosine.min() > 0.99
     assert len(edges(mesh.triangles)) == 3 * len(mesh.triangles) // 2  # closed: each edge in two triangles
+
+
+def test_smoothing_moves_only_the_chosen_rows():
+    from autorig_addon.core.mesh_ops import smooth_over_edges
+
+    mesh = grid(2, 2)  # one quad, two triangles
+    values = np.array([[1.0], [0.0], [0.0], [0.0]])
+    smoothed = smooth_over_edges(values, mesh.triangles, iterations=1, strength=0.5, rows=np.array([True, False, False, False]))
+    assert smoothed[0, 0] == pytest.approx(0.5)  # half its own value, half its neighbours' mean (0)
+    np.testing.assert_array_equal(smoothed[1:], values[1:])
+    all_rows = smooth_over_edges(values, mesh.triangles, iterations=1, strength=0.5)
+    assert all_rows[1:].sum() > 0  # without a mask the neighbours take some of vertex 0's value

@@ -82,3 +82,21 @@ def test_import_with_wrong_vertex_count_leaves_the_scene_unchanged(clean_scene, 
         bpy.ops.autorig.import_rignet(filepath=str(path))
     assert sorted(o.name for o in bpy.data.objects) == before
     assert len(small.vertex_groups) == 0
+
+
+def test_import_onto_a_mesh_with_more_vertices_than_the_file_is_refused(clean_scene, tmp_path):
+    import bpy
+
+    from blender_fixtures import mesh_object
+
+    path = tmp_path / "rig.txt"
+    path.write_text("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
+                    "skin 0 root 1.0\nskin 1 tip 1.0\nskin 2 root 0.5 tip 0.5\n")
+    bigger = mesh_object("Bigger", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+    bpy.context.view_layer.update()
+    select_only([bigger], active=bigger)
+    before = sorted(o.name for o in bpy.data.objects)
+    with pytest.raises(RuntimeError, match="not the mesh the rig was made for"):
+        bpy.ops.autorig.import_rignet(filepath=str(path))
+    assert sorted(o.name for o in bpy.data.objects) == before
+    assert len(bigger.vertex_groups) == 0

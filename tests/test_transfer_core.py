@@ -195,3 +195,16 @@ def test_non_manifold_edge_is_handled_and_reported(body):
     assert "1 non-manifold edges" in result.summary()
     assert np.all(np.isfinite(result.weights.matrix))
     np.testing.assert_allclose(result.weights.matrix.sum(axis=1), 1.0, atol=1e-12)
+
+
+def test_overlap_check_honours_a_larger_match_distance(body):
+    source, weights = body
+    # A 0.2 x 0.2 patch facing +x, 0.08 beside the body: outside the default
+    # margin (5 % of its 0.28 diagonal) but inside a 50 % one.
+    patch = grid(5, 5, size=0.2)
+    y, z = patch.vertices[:, 0] - 0.1, patch.vertices[:, 1] + 0.4
+    target = Mesh(np.column_stack([np.full(len(y), 0.18), y, z]), patch.triangles)
+    with pytest.raises(InputError, match="does not overlap"):
+        transfer_weights(source, weights, target)
+    result = transfer_weights(source, weights, target, TransferOptions(distance_fraction=0.5))
+    assert np.count_nonzero(result.status == VertexStatus.COPIED) > 0

@@ -320,10 +320,19 @@ class _GroupState:
     weights: np.ndarray
 
 
+#: Armature modifier settings a snapshot records, so a removed one can be rebuilt.
+_ARMATURE_MODIFIER_SETTINGS = (
+    "use_vertex_groups", "use_bone_envelopes", "use_deform_preserve_volume", "use_multi_modifier",
+    "show_viewport", "show_render", "show_in_editmode", "show_on_cage",
+)
+
+
 @dataclass
 class _ModifierState:
     name: str
     armature: object
+    index: int
+    settings: dict
 
 
 @dataclass
@@ -368,7 +377,9 @@ class ObjectSnapshot:
         snapshot.active_group_index = obj.vertex_groups.active_index
         snapshot.modifier_names = [modifier.name for modifier in obj.modifiers]
         snapshot.armature_modifiers = [
-            _ModifierState(modifier.name, modifier.object) for modifier in obj.modifiers if modifier.type == "ARMATURE"
+            _ModifierState(modifier.name, modifier.object, index,
+                           {name: getattr(modifier, name) for name in _ARMATURE_MODIFIER_SETTINGS})
+            for index, modifier in enumerate(obj.modifiers) if modifier.type == "ARMATURE"
         ]
         snapshot.parent = obj.parent
         snapshot.parent_type = obj.parent_type
@@ -397,8 +408,14 @@ class ObjectSnapshot:
                 obj.modifiers.remove(modifier)
         for state in self.armature_modifiers:
             modifier = obj.modifiers.get(state.name)
-            if modifier is not None:
-                modifier.object = state.armature
+            if modifier is None:
+                modifier = obj.modifiers.new(state.name, "ARMATURE")
+            modifier.object = state.armature
+            for name, value in state.settings.items():
+                setattr(modifier, name, value)
+            current = list(obj.modifiers).index(modifier)
+            if current != state.index:
+                obj.modifiers.move(current, min(state.index, len(obj.modifiers) - 1))
         obj.parent = self.parent
         obj.parent_type = self.parent_type
         obj.matrix_parent_inverse = self.matrix_parent_inverse
@@ -451,17 +468,20 @@ def _clear_group(group, vertex_count: int) -> None:
 
 
 def ensure_armature_binding(obj, armature_obj) -> None:
-    """Give ``obj`` exactly one Armature modifier on ``armature_obj`` and
-    parent it to the armature, keeping its world transform."""
-    bound = [m for m in obj.modifiers if m.type == "ARMATURE" and m.object == armature_obj]
-    unbound = [m for m in obj.modifiers if m.type == "ARMATURE" and m.object is None]
-    if bound:
-        keep = bound[0]
-        for modifier in bound[1:]:
-            obj.modifiers.remove(modifier)
-    elif unbound:
-        keep = unbound[0]
+    """Give ``obj`` exactly one Armature modifier, on ``armature_obj``, and
+    parent it to the armature, keeping its world transform.
+
+    An existing Armature modifier is reused (one on this armature first,
+    then an empty one, then one on another armature, which is retargeted);
+    every other Armature modifier is removed, or the mesh would be deformed
+    twice. :class:`ObjectSnapshot` can rebuild them."""
+    armature_modifiers = [m for m in obj.modifiers if m.type == "ARMATURE"]
+    ranked = sorted(armature_modifiers, key=lambda m: (m.object != armature_obj, m.object is not None))
+    if ranked:
+        keep = ranked[0]
         keep.object = armature_obj
+        for modifier in ranked[1:]:
+            obj.modifiers.remove(modifier)
     else:
         keep = obj.modifiers.new(ARMATURE_MODIFIER_NAME, "ARMATURE")
         keep.object = armature_obj

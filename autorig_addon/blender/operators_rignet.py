@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 
 import bpy
+import numpy as np
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
@@ -33,6 +34,15 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
     armature = build_armature(skeleton, name, context)
     if mesh_obj is None or weights is None:
         return armature
+    skinned = np.flatnonzero(weights.matrix.any(axis=1))
+    if len(skinned) and skinned[-1] + 1 != vertex_count:
+        data = armature.data
+        bpy.data.objects.remove(armature)
+        bpy.data.armatures.remove(data)
+        raise InputError(
+            f"The file weights vertices up to {skinned[-1]}, but '{mesh_obj.name}' has {vertex_count} vertices: "
+            "it is not the mesh the rig was made for. Import without a mesh selected to get the armature alone."
+        )
     try:
         convert.write_weights(mesh_obj, weights, armature)
     except BaseException:

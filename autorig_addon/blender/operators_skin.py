@@ -30,8 +30,9 @@ from . import convert
 from .progress import blender_progress
 from .properties import SKIN_OPTION_NAMES, SkinOptionProperties
 
-#: A deform bone farther than this many mesh diagonals from the mesh's
-#: bounding box means the armature was not placed on the character.
+#: When even the deform bone point nearest the mesh's bounding box is
+#: farther than this many mesh diagonals from it, the armature was not
+#: placed on the character.
 MAX_ARMATURE_OFFSET = 0.5
 #: Deform bones shorter than this fraction of the skeleton's size count as zero-length
 #: (they have no direction to measure distances along).

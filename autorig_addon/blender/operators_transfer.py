@@ -262,17 +262,9 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) 
         bone_names=bone_names,
         transferred_bones=_transferred_bones(settings, bone_names, armature),
         source_mesh=source_mesh,
-        source_weights=Weights(_rows_summing_to_one(source_weights.matrix), bone_names),
+        source_weights=Weights(normalize_rows(source_weights.matrix), bone_names),
         settings=settings,
     )
-
-
-def _rows_summing_to_one(matrix: np.ndarray) -> np.ndarray:
-    """(n, b) rows scaled to sum to one, as Blender's Armature modifier
-    normalises them; all-zero rows stay zero. Blender stores weights in
-    [0, 1], so the NaN clean-up of ``normalize_rows`` is not needed here."""
-    sums = matrix.sum(axis=1, keepdims=True)
-    return np.divide(matrix, sums, out=np.zeros_like(matrix), where=sums > 0)
 
 
 def combine_with_existing(existing: np.ndarray, incoming: np.ndarray, columns: np.ndarray, settings: TransferSettings) -> np.ndarray:

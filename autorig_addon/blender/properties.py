@@ -143,9 +143,10 @@ from ..core.geometric_skinning import (  # noqa: E402  (defaults shared with the
     DEFAULT_FALLOFF,
     DEFAULT_METHOD,
     DEFAULT_MAX_INFLUENCES,
-    DEFAULT_SMOOTHING_ITERATIONS,
 )
-from ..core.voxelize import DEFAULT_RESOLUTION  # noqa: E402
+from ..core.geometric_skinning import DEFAULT_SMOOTHING_ITERATIONS as DEFAULT_SKIN_SMOOTHING_ITERATIONS  # noqa: E402
+from ..core.geometric_skinning import DEFAULT_SMOOTHING_STRENGTH as DEFAULT_SKIN_SMOOTHING_STRENGTH  # noqa: E402
+from ..core.voxelize import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION  # noqa: E402
 
 SKIN_DISTANCE_ITEMS = (
     ("GEODESIC", "Volumetric Geodesic",
@@ -165,7 +166,7 @@ class SkinOptionProperties:
     skin_resolution: IntProperty(
         name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "
         "(fingers, cloth) better and costs more time and memory",
-        min=16, max=512, soft_max=256, default=DEFAULT_RESOLUTION,
+        min=MIN_RESOLUTION, max=MAX_RESOLUTION, soft_min=16, soft_max=256, default=DEFAULT_RESOLUTION,
     )
     skin_falloff: FloatProperty(
         name="Falloff", description="Heat strength: how fast a bone's influence falls off away from the "
@@ -179,11 +180,11 @@ class SkinOptionProperties:
     skin_smoothing_iterations: IntProperty(
         name="Smoothing", description="Extra smoothing passes of the weights over the surface "
         "(the heat diffusion is already smooth)",
-        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SMOOTHING_ITERATIONS,
+        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SKIN_SMOOTHING_ITERATIONS,
     )
     skin_smoothing_strength: FloatProperty(
         name="Smoothing Strength", description="Blend factor of one smoothing pass",
-        subtype="FACTOR", min=0.0, max=1.0, default=DEFAULT_SMOOTHING_STRENGTH,
+        subtype="FACTOR", min=0.0, max=1.0, default=DEFAULT_SKIN_SMOOTHING_STRENGTH,
     )
     skin_replace_all: BoolProperty(
         name="Replace All Groups", description="Remove every existing vertex group of the meshes first "

@@ -47,7 +47,13 @@ from scipy.sparse.linalg import splu
 
 from .errors import InputError
 from .hollow_dist import hollow_distances
-from .mesh_ops import adjacency_matrix, connected_component_labels, cotangent_laplacian, voronoi_mass, weld_vertices
+from .mesh_ops import (
+    connected_component_labels,
+    cotangent_laplacian,
+    smooth_over_edges,
+    voronoi_mass,
+    weld_vertices,
+)
 from .progress import ProgressCallback, report, sub_progress
 from .types import Mesh, Skeleton, Weights
 from .volumetric_geodesic import volumetric_geodesic_distances
@@ -135,7 +141,7 @@ def geometric_weights(
         distances = _checked_distances(distances, mesh.vertex_count, len(deform))
     report(progress, 0.9, "Diffusing bone heat")
     weights = heat_diffusion_weights(mesh, distances, falloff, sees_nearest_bone(mesh.vertices, distances, heads, tails))
-    weights = smooth_over_surface(weights, mesh, smoothing_iterations, smoothing_strength)
+    weights = smooth_over_edges(weights, mesh.triangles, smoothing_iterations, smoothing_strength)
     weights = prune_small(limit_influences(weights, max_influences))
     weights = _nearest_bone_where_empty(weights, distances)
     report(progress, 1.0, "Weights done")
@@ -203,40 +209,10 @@ def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, he
     return np.maximum(weights, 0.0)[to_welded]
 
 
-def smooth_over_surface(weights: np.ndarray, mesh: Mesh, iterations: int, strength: float) -> np.ndarray:
-    """Uniform Laplacian smoothing of per-vertex values along mesh edges.
-
-    Each pass replaces a vertex's row by ``(1 - strength) * row + strength *
-    mean of its neighbours' rows``. Vertices without edges keep their rows;
-    loose parts never exchange values.
-
-    Parameters
-    ----------
-    weights : (n, b) float64 array
-    mesh : Mesh with n vertices
-    iterations : int >= 0
-    strength : float in [0, 1]
-
-    Returns
-    -------
-    (n, b) float64 array.
-    """
-    if iterations <= 0 or strength <= 0 or not len(mesh.triangles):
-        return np.asarray(weights, dtype=np.float64)
-    adjacency = adjacency_matrix(mesh.triangles, mesh.vertex_count)
-    degree = np.asarray(adjacency.sum(axis=1)).ravel()
-    has_neighbours = degree > 0
-    mean_of_neighbours = sp.diags(np.divide(1.0, degree, out=np.zeros_like(degree), where=has_neighbours)) @ adjacency
-    blend = np.where(has_neighbours, strength, 0.0)[:, None]
-    smoothed = np.asarray(weights, dtype=np.float64)
-    for _ in range(int(iterations)):
-        smoothed = (1.0 - blend) * smoothed + blend * (mean_of_neighbours @ smoothed)
-    return smoothed
-
-
 def _nearest_bone_where_empty(weights: np.ndarray, distances: np.ndarray) -> np.ndarray:
-    """Give any row left without weight its nearest bone (a guard: the
-    falloff gives every row a weight of 1 somewhere)."""
+    """Give any row left without weight its nearest bone (a guard: heat
+    reaches every vertex of a connected part, but pruning could empty a row
+    whose weights were all tiny)."""
     empty = empty_rows(weights)
     if not empty.any():
         return weights

@@ -31,10 +31,10 @@ from scipy.sparse.linalg import splu
 from .closest_point import TriangleMeshQuery
 from .errors import InputError
 from .mesh_ops import (
-    adjacency_matrix,
     connected_component_labels,
     cotangent_laplacian,
     non_manifold_edge_count,
+    smooth_over_edges,
     vertex_normals,
     voronoi_mass,
     weld_vertices,
@@ -227,20 +227,6 @@ def inpaint_weights(Q: sp.spmatrix, known: np.ndarray, known_weights: np.ndarray
     return result
 
 
-def smooth_rows(weights: np.ndarray, adjacency: sp.spmatrix, rows: np.ndarray, iterations: int, strength: float) -> np.ndarray:
-    """Blend ``rows`` of ``weights`` toward their neighbours' mean,
-    ``iterations`` times by ``strength``; other rows are left alone."""
-    if iterations <= 0 or strength <= 0 or not np.any(rows):
-        return weights
-    degree = np.asarray(adjacency.sum(axis=1)).ravel()
-    has_neighbours = rows & (degree > 0)
-    smoothed = weights.copy()
-    for _ in range(int(iterations)):
-        mean = (adjacency @ smoothed)[has_neighbours] / degree[has_neighbours, None]
-        smoothed[has_neighbours] = (1.0 - strength) * smoothed[has_neighbours] + strength * mean
-    return smoothed
-
-
 def transfer_weights(
     source: Mesh,
     source_weights: Weights,
@@ -327,9 +313,7 @@ def transfer_weights(
     solved = normalize_rows(inpaint_weights(Q, known, known_weights))
     empty = ~(solved.sum(axis=1) > 0)
     solved[empty] = matches.weights[empty]
-    solved = smooth_rows(
-        solved, adjacency_matrix(welded_F, count), ~known, options.smoothing_iterations, options.smoothing_strength,
-    )
+    solved = smooth_over_edges(solved, welded_F, options.smoothing_iterations, options.smoothing_strength, rows=~known)
     solved = prune_small(limit_influences(solved, options.max_influences))
     timings["inpaint"] = time.perf_counter() - clock
     report(progress, 0.9, "Writing results")
@@ -374,7 +358,7 @@ def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: 
             f"The target is {target_diagonal / max(source_diagonal, 1e-300):.0f} times larger than the source: "
             "the objects look like they are at different scales. Apply their scale (Ctrl+A) or fix the units."
         )
-    margin = DEFAULT_DISTANCE_FRACTION * target_diagonal if options.max_distance is None else options.max_distance
+    margin = options.distance_fraction * target_diagonal if options.max_distance is None else options.max_distance
     source_min, source_max = source.vertices.min(0) - margin, source.vertices.max(0) + margin
     target_min, target_max = target.vertices.min(0), target.vertices.max(0)
     if np.any(target_min > source_max) or np.any(target_max < source_min):

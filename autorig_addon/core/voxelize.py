@@ -70,6 +70,8 @@ MAX_BLOCK_CELLS = 8
 #: Memory for one batch of Dijkstra results (8 bytes per node per bone);
 #: bones are processed in batches that fit.
 DIJKSTRA_BATCH_BYTES = 64 << 20
+#: Memory for the temporaries of one chunk of point-to-segment distances.
+POINT_SEGMENT_CHUNK_BYTES = 64 << 20
 #: Graph paths are staircases of 26-neighbour steps, at most this many
 #: times the straight length (worst direction about (1, 0.41, 0.32)).
 STAIRCASE_RATIO = 1.13
@@ -405,15 +407,22 @@ def point_segment_distances(points: np.ndarray, heads: np.ndarray, tails: np.nda
     ----------
     points : (k, 3) float64 array
     heads, tails : (b, 3) float64 arrays, segment ends (zero length allowed)
+
+    Works through the points in chunks so the (chunk, b, 3) temporaries stay
+    under :data:`POINT_SEGMENT_CHUNK_BYTES` however many points there are.
     """
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     heads = np.asarray(heads, dtype=np.float64).reshape(-1, 3)
     direction = np.asarray(tails, dtype=np.float64).reshape(-1, 3) - heads
     length_sq = np.einsum("ij,ij->i", direction, direction)
-    relative = points[:, None, :] - heads[None, :, :]  # (k, b, 3)
-    t = np.einsum("kbi,bi->kb", relative, direction) / np.where(length_sq > 0, length_sq, 1.0)
-    t = np.clip(t, 0.0, 1.0)
-    return np.linalg.norm(relative - t[:, :, None] * direction[None, :, :], axis=2)
+    safe_length_sq = np.where(length_sq > 0, length_sq, 1.0)
+    out = np.empty((len(points), len(heads)))
+    chunk = max(1, POINT_SEGMENT_CHUNK_BYTES // (24 * max(len(heads), 1)))
+    for start in range(0, len(points), chunk):
+        relative = points[start:start + chunk, None, :] - heads[None, :, :]  # (c, b, 3)
+        t = np.clip(np.einsum("kbi,bi->kb", relative, direction) / safe_length_sq, 0.0, 1.0)
+        out[start:start + chunk] = np.linalg.norm(relative - t[:, :, None] * direction[None, :, :], axis=2)
+    return out
 
 
 # --------------------------------------------------------------------------
