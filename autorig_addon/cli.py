@@ -255,11 +255,14 @@ def _add_transfer_arguments(parser: argparse.ArgumentParser) -> None:
         "--target", action="append", default=[], metavar="OBJ",
         help="Mesh to weight (repeat, or comma-separate; default: every mesh not bound to an armature)",
     )
-    parser.add_argument("--distance-fraction", type=_positive, default=0.05,
-                        help="Match distance as a fraction of the target's bounding-box diagonal (default 0.05)")
+    from .core import transfer
+
+    parser.add_argument("--distance-fraction", type=_positive, default=transfer.DEFAULT_DISTANCE_FRACTION,
+                        help="Match distance as a fraction of the target's bounding-box diagonal "
+                             f"(default {transfer.DEFAULT_DISTANCE_FRACTION})")
     parser.add_argument("--max-distance", type=_positive, default=None,
                         help="Match distance in scene units; overrides --distance-fraction")
-    parser.add_argument("--max-normal-angle", type=_positive, default=30.0,
+    parser.add_argument("--max-normal-angle", type=_positive, default=transfer.DEFAULT_MAX_NORMAL_ANGLE,
                         help="Largest normal disagreement for a match, degrees (default 30)")
     parser.add_argument("--flipped-normals", action=argparse.BooleanOptionalAction, default=True,
                         help="Also match opposite normals, for inner layers (default on)")

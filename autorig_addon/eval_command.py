@@ -149,17 +149,9 @@ def _nearest_bone(task: SkinInput):
 
 
 def _geometric(task: SkinInput):
-    return _geometric_weights_function()(task.mesh, task.skeleton)
+    from .core.geometric_skinning import geometric_weights
 
-
-def _geometric_weights_function():
-    from .core.errors import InputError
-
-    try:
-        from .core.geometric_skinning import geometric_weights
-    except ImportError as error:
-        raise InputError(f"The geometric skinning method is not available in this version ({error}).") from None
-    return geometric_weights
+    return geometric_weights(task.mesh, task.skeleton)
 
 
 def _closest_point_transfer(source, source_weights, target):
@@ -397,8 +389,6 @@ def check_method(task: str, method: str) -> None:
     if task == "skin":
         if method != REFERENCE_METHOD and method not in SKIN_METHODS:
             raise InputError(f"Unknown skin method '{method}': use one of {sorted(SKIN_METHODS) + [REFERENCE_METHOD]}.")
-        if method == "geometric":
-            _geometric_weights_function()
     elif task == "rig":
         _rig_predictor(method)
     elif method not in TRANSFER_METHODS:

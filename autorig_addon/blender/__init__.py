@@ -13,7 +13,7 @@ import bpy
 
 #: Modules with a ``classes`` tuple, in registration order (property groups
 #: before the operators and panels that use them).
-_MODULE_NAMES = ("properties", "preferences", "operators_transfer", "operators_skin", "operators_rignet", "panels")
+_MODULE_NAMES = ("properties", "operators_transfer", "operators_skin", "operators_rignet", "panels")
 
 
 def _modules():

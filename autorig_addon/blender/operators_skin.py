@@ -28,6 +28,7 @@ from ..core.types import Mesh, Skeleton, Weights
 from ..core.voxelize import DEFAULT_RESOLUTION
 from . import convert
 from .progress import blender_progress
+from .scene_io import find_object
 from .properties import SKIN_OPTION_NAMES, SkinOptionProperties
 
 #: When even the deform bone point nearest the mesh's bounding box is
@@ -76,7 +77,7 @@ class SkinPlan:
     settings: SkinSettings
 
 
-def _check_not_in_edit_mode(obj) -> None:
+def _check_in_object_mode(obj) -> None:
     if obj.mode != "OBJECT":
         raise InputError(f"'{obj.name}' is in {obj.mode.replace('_', ' ').title()} Mode: leave it first.")
 
@@ -99,7 +100,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph) -> Skin
     if not meshes:
         raise InputError("Select the mesh(es) to skin together with the armature.")
     for obj in [armature, *meshes]:
-        _check_not_in_edit_mode(obj)
+        _check_in_object_mode(obj)
     for obj in meshes:
         convert.require_mesh_object(obj, "mesh to skin")
     skeleton = convert.read_skeleton(armature)
@@ -156,16 +157,8 @@ def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
     (the active or selected armature and the selected meshes)."""
     from .operators_transfer import split_names
 
-    def named(name, kind):
-        obj = bpy.data.objects.get(name)
-        if obj is None:
-            raise InputError(f"No object named '{name}'.")
-        if obj.type != kind:
-            raise InputError(f"'{name}' is not a{'n armature' if kind == 'ARMATURE' else ' mesh'}.")
-        return obj
-
     if armature_name:
-        armature = named(armature_name, "ARMATURE")
+        armature = find_object(armature_name, "ARMATURE")
     else:
         armatures = [obj for obj in context.selected_objects if obj.type == "ARMATURE"]
         active = context.active_object
@@ -176,7 +169,7 @@ def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
         else:
             raise InputError("Select one armature (and the meshes to skin), or name it.")
     if mesh_names.strip():
-        meshes = [named(name, "MESH") for name in split_names(mesh_names)]
+        meshes = [find_object(name, "MESH") for name in split_names(mesh_names)]
     else:
         meshes = [obj for obj in context.selected_objects if obj.type == "MESH"]
     return armature, meshes

@@ -17,6 +17,7 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
+from ..core import transfer
 from ..core.errors import Cancelled, InputError
 from ..core.progress import ProgressCallback, report, sub_progress
 from ..core.types import Mesh, Weights
@@ -46,12 +47,12 @@ class TransferSettings:
     mix_factor : float in [0, 1], used by "MIX"
     """
 
-    distance_fraction: float = 0.05
+    distance_fraction: float = transfer.DEFAULT_DISTANCE_FRACTION
     max_distance: float | None = None
-    max_normal_angle: float = 30.0
+    max_normal_angle: float = transfer.DEFAULT_MAX_NORMAL_ANGLE
     accept_flipped_normals: bool = True
-    smoothing_iterations: int = 0
-    smoothing_strength: float = 0.5
+    smoothing_iterations: int = transfer.DEFAULT_SMOOTHING_ITERATIONS
+    smoothing_strength: float = transfer.DEFAULT_SMOOTHING_STRENGTH
     max_influences: int = 0
     mask_group: str = ""
     protect_group: str = ""

@@ -10,18 +10,17 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-#: Default match distance as a fraction of the target's bounding-box diagonal (paper: 0.05).
-DEFAULT_DISTANCE_FRACTION = 0.05
+from ..core.transfer import (  # the transfer defaults live with the algorithm
+    DEFAULT_DISTANCE_FRACTION,
+    DEFAULT_SMOOTHING_ITERATIONS,
+    DEFAULT_SMOOTHING_STRENGTH,
+)
+from ..core.transfer import DEFAULT_MAX_NORMAL_ANGLE as DEFAULT_MAX_NORMAL_ANGLE_DEGREES
+
 #: Default absolute match distance, metres, used only when "Absolute Distance" is on.
 DEFAULT_MAX_DISTANCE = 0.05
-#: Default largest normal angle for a match, degrees (paper: 30).
-DEFAULT_MAX_NORMAL_ANGLE_DEGREES = 30.0
-#: Default Laplacian smoothing passes over inpainted vertices.
-DEFAULT_SMOOTHING_ITERATIONS = 0
 #: Most smoothing passes the UI offers.
 MAX_SMOOTHING_ITERATIONS = 100
-#: Default blend factor of one smoothing pass.
-DEFAULT_SMOOTHING_STRENGTH = 0.5
 #: Most influences per vertex the UI offers (0 = no limit).
 MAX_INFLUENCES_LIMIT = 16
 #: Default name of the vertex group that forces inpainting.

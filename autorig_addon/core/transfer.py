@@ -47,6 +47,10 @@ from .weights import check_weights, limit_influences, normalize_rows, prune_smal
 DEFAULT_DISTANCE_FRACTION = 0.05
 #: Default largest angle between target and source normals for a match, degrees (paper: 30).
 DEFAULT_MAX_NORMAL_ANGLE = 30.0
+#: Default Laplacian smoothing passes over inpainted vertices (0: none).
+DEFAULT_SMOOTHING_ITERATIONS = 0
+#: Default blend factor of one smoothing pass, in [0, 1].
+DEFAULT_SMOOTHING_STRENGTH = 0.5
 #: Vertices closer than this fraction of the target diagonal are welded for inpainting.
 WELD_FRACTION = 1e-6
 #: A target larger than this many source diagonals is taken as a unit mismatch.
@@ -93,8 +97,8 @@ class TransferOptions:
     max_distance: float | None = None
     max_normal_angle: float = DEFAULT_MAX_NORMAL_ANGLE
     accept_flipped_normals: bool = True
-    smoothing_iterations: int = 0
-    smoothing_strength: float = 0.5
+    smoothing_iterations: int = DEFAULT_SMOOTHING_ITERATIONS
+    smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
     max_influences: int = 0
 
 
