@@ -335,10 +335,24 @@ def test_transfer_panel_draws_every_setting_and_the_buttons(rig):
     select_only([rig.body, rig.sleeve], active=rig.sleeve)
     bpy.context.scene.autorig.source = rig.body
     log = []
-    panel = SimpleNamespace(layout=RecordingLayout(log))
-    VIEW3D_PT_autorig_transfer.draw(panel, bpy.context)
+    layout = RecordingLayout(log)
+    VIEW3D_PT_autorig_transfer.draw_settings(SimpleNamespace(), layout, bpy.context.scene.autorig, bpy.context)
     drawn = {name for kind, name in log if kind == "prop"}
     # Either the fraction or the absolute distance shows, never both.
     assert drawn == {"source", "target", *TRANSFER_OPTION_NAMES} - {"max_distance"}
     assert ("operator", "autorig.transfer_weights") in log and ("operator", "autorig.create_transfer_mask") in log
     assert ("label", "Targets: Sleeve") in log
+
+
+def test_skin_panel_draws_every_skin_setting_and_the_button(rig):
+    from types import SimpleNamespace
+
+    from autorig_addon.blender.panels import VIEW3D_PT_autorig_skin
+    from autorig_addon.blender.properties import SKIN_OPTION_NAMES
+
+    select_only([rig.armature, rig.sleeve], active=rig.armature)
+    log = []
+    VIEW3D_PT_autorig_skin.draw_settings(SimpleNamespace(), RecordingLayout(log), bpy.context.scene.autorig, bpy.context)
+    assert {name for kind, name in log if kind == "prop"} == set(SKIN_OPTION_NAMES)
+    assert ("operator", "autorig.skin_weights") in log
+    assert ("label", f"Sleeve to {rig.armature.name}") in log

@@ -30,8 +30,10 @@ def _target_names(context, settings) -> list[str]:
     return names
 
 
-class VIEW3D_PT_autorig_transfer(bpy.types.Panel):
-    bl_label = "Weight Transfer"
+class _AutoRigSubPanel:
+    """Shared placement of the panels under the AutoRig parent panel; a
+    subclass draws with ``draw_settings(layout, settings, context)``."""
+
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = SIDEBAR_CATEGORY
@@ -45,7 +47,13 @@ class VIEW3D_PT_autorig_transfer(bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        settings = context.scene.autorig
+        self.draw_settings(layout, context.scene.autorig, context)
+
+
+class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
+    bl_label = "Weight Transfer"
+
+    def draw_settings(self, layout, settings, context):
 
         column = layout.column(align=True)
         column.prop(settings, "source")
@@ -93,22 +101,10 @@ class VIEW3D_PT_autorig_transfer(bpy.types.Panel):
         layout.operator(AUTORIG_OT_transfer_weights.bl_idname, icon="MOD_VERTEX_WEIGHT")
 
 
-class VIEW3D_PT_autorig_skin(bpy.types.Panel):
+class VIEW3D_PT_autorig_skin(_AutoRigSubPanel, bpy.types.Panel):
     bl_label = "Skin Weights"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = SIDEBAR_CATEGORY
-    bl_parent_id = "VIEW3D_PT_autorig"
 
-    @classmethod
-    def poll(cls, context):
-        return getattr(context.scene, "autorig", None) is not None
-
-    def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.autorig
+    def draw_settings(self, layout, settings, context):
         armatures = [obj.name for obj in context.selected_objects if obj.type == "ARMATURE"]
         meshes = [obj.name for obj in context.selected_objects if obj.type == "MESH"]
         column = layout.column(align=True)
