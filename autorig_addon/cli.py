@@ -233,7 +233,7 @@ def _positive(text: str) -> float:
 
 
 def _resolution(text: str) -> int:
-    from .core.voxelize import MAX_RESOLUTION, MIN_RESOLUTION
+    from .core.distances.voxelize import MAX_RESOLUTION, MIN_RESOLUTION
 
     value = int(text)
     if not MIN_RESOLUTION <= value <= MAX_RESOLUTION:
@@ -255,7 +255,7 @@ def _add_transfer_arguments(parser: argparse.ArgumentParser) -> None:
         "--target", action="append", default=[], metavar="OBJ",
         help="Mesh to weight (repeat, or comma-separate; default: every mesh not bound to an armature)",
     )
-    from .core import transfer
+    from .core.transfer import transfer
 
     parser.add_argument("--distance-fraction", type=_positive, default=transfer.DEFAULT_DISTANCE_FRACTION,
                         help="Match distance as a fraction of the target's bounding-box diagonal "
@@ -284,7 +284,7 @@ def _add_transfer_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _transfer_settings(args: argparse.Namespace):
-    from .blender.operators_transfer import TransferSettings, split_names
+    from .blender.operators.transfer import TransferSettings, split_names
 
     replace = args.replace or ("mix" if args.mix is not None else "transfer")
     bones = tuple(split_names(args.bones)) if args.bones.strip() else None
@@ -328,7 +328,7 @@ def _transfer_one(args: argparse.Namespace, settings, input_path: Path, output_p
     import bpy
 
     from .blender import scene_io
-    from .blender.operators_transfer import run_transfer, split_names
+    from .blender.operators.transfer import run_transfer, split_names
 
     scene_io.load_scene(input_path)
     source = scene_io.find_object(args.source, "MESH")
@@ -379,7 +379,7 @@ def _default_skin_objects(armature_name: str, mesh_names: list[str]):
     import bpy
 
     from .blender import scene_io
-    from .blender.operators_transfer import split_names
+    from .blender.operators.transfer import split_names
     from .core.errors import InputError
 
     if armature_name:
@@ -409,7 +409,7 @@ def _run_skin(args: argparse.Namespace) -> int:
         import bpy
 
         from .blender import scene_io
-        from .blender.operators_skin import SkinSettings, run_skin
+        from .blender.operators.skin import SkinSettings, run_skin
 
         scene_io.load_scene(input_path)
         armature, meshes = _default_skin_objects(args.armature, args.mesh)

@@ -143,19 +143,19 @@ def _bone_heat(task: SkinInput):
 
 
 def _nearest_bone(task: SkinInput):
-    from .core.nearest_bone import nearest_bone_weights
+    from .core.skinning.nearest_bone import nearest_bone_weights
 
     return nearest_bone_weights(task.mesh, task.skeleton)
 
 
 def _geometric(task: SkinInput):
-    from .core.geometric_skinning import geometric_weights
+    from .core.skinning.geometric import geometric_weights
 
     return geometric_weights(task.mesh, task.skeleton)
 
 
 def _closest_point_transfer(source, source_weights, target):
-    from .core.closest_point import TriangleMeshQuery
+    from .core.geometry.closest_point import TriangleMeshQuery
     from .core.types import Weights
     from .core.weights import normalize_rows
 
@@ -164,7 +164,7 @@ def _closest_point_transfer(source, source_weights, target):
 
 
 def _robust_transfer(source, source_weights, target):
-    from .core.transfer import transfer_weights
+    from .core.transfer.transfer import transfer_weights
 
     return transfer_weights(source, source_weights, target).weights
 
@@ -232,7 +232,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     InputError when nothing is left to evaluate.
     """
     from .cli import INPUT_EXTENSIONS
-    from .core import dataset
+    from .core.dataset import dataset
     from .core.errors import InputError
 
     split_path = Path(split_file) if split_file else DEFAULT_SPLIT_FILE
@@ -302,8 +302,8 @@ def skin_scores(vertices: np.ndarray, predicted, reference, skeleton, poses: Opt
     Predicted rows are normalised; vertices without reference weight are
     left out of every metric.
     """
-    from .core.deformation import character_size, deformation_error, random_poses
-    from .core.skin_metrics import influence_precision_recall, skin_l1
+    from .core.evaluation.deformation import character_size, deformation_error, random_poses
+    from .core.evaluation.skin_metrics import influence_precision_recall, skin_l1
     from .core.types import Skeleton
     from .core.weights import INFLUENCE_EPSILON, normalize_rows
 
@@ -340,7 +340,7 @@ def skin_scores(vertices: np.ndarray, predicted, reference, skeleton, poses: Opt
 def self_transfer_target(mesh, size: float):
     """The character's surface pushed out along its vertex normals by
     :data:`SELF_TRANSFER_OFFSET_FRACTION` of ``size`` (same vertex order)."""
-    from .core.mesh_ops import vertex_normals
+    from .core.geometry.mesh_ops import vertex_normals
     from .core.types import Mesh
 
     offset = SELF_TRANSFER_OFFSET_FRACTION * size * vertex_normals(mesh.vertices, mesh.triangles)
@@ -366,7 +366,7 @@ def _rig_predictor(method: str) -> Callable:
             raise InputError(f"The folder of predicted rigs '{folder}' does not exist.")
 
         def read_predicted(mesh, item: DataItem):
-            from .core.rignet_format import read_rignet_rig
+            from .core.io.rignet_rig import read_rignet_rig
 
             candidates = [folder / f"{item.name}.txt", folder / f"{item.name}_rig.txt",
                           folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
@@ -413,7 +413,7 @@ def evaluate_skin_item(item: DataItem, method: str) -> dict:
 def evaluate_rig_item(item: DataItem, method: str) -> dict:
     """Load one character, predict its rig from the mesh alone and score it."""
     from .blender.characters import load_character
-    from .core.skeleton_metrics import evaluate_rig
+    from .core.evaluation.skeleton_metrics import evaluate_rig
 
     character = load_character(item.path, item.name, item.category)
     predicted, seconds = _predict_timed(_rig_predictor(method), character.mesh, item)
@@ -455,9 +455,9 @@ def evaluate_transfer_item(item: DataItem, method: str, source: Optional[_Transf
     """Transfer onto one DATA file: a self-transfer check for a rigged
     character, a garment transfer from ``source`` otherwise."""
     from .blender import characters, scene_io
-    from .core.deformation import unique_edges
+    from .core.evaluation.deformation import unique_edges
     from .core.errors import InputError
-    from .core.skin_metrics import evaluate_transfer
+    from .core.evaluation.skin_metrics import evaluate_transfer
 
     scene_io.load_scene(item.path)
     try:

@@ -29,10 +29,10 @@ sys.path.insert(0, REPO)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.hollow_dist import build_hollow_graph, refine_hollow_in_sight  # noqa: E402
+from autorig_addon.core.distances.hollow_dist import build_hollow_graph, refine_hollow_in_sight  # noqa: E402
 from autorig_addon.core.types import Mesh, Skeleton  # noqa: E402
-from autorig_addon.core.volumetric_geodesic import build_geodesic_graph  # noqa: E402
-from autorig_addon.core.voxelize import (  # noqa: E402
+from autorig_addon.core.distances.volumetric_geodesic import build_geodesic_graph  # noqa: E402
+from autorig_addon.core.distances.voxelize import (  # noqa: E402
     bone_node_distances,
     combine_vertex_distances,
     fill_interior,

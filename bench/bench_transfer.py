@@ -26,8 +26,8 @@ sys.path.insert(0, REPO)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.closest_point import TriangleMeshQuery  # noqa: E402
-from autorig_addon.core.transfer import transfer_weights  # noqa: E402
+from autorig_addon.core.geometry.closest_point import TriangleMeshQuery  # noqa: E402
+from autorig_addon.core.transfer.transfer import transfer_weights  # noqa: E402
 from autorig_addon.core.types import Weights  # noqa: E402
 from autorig_addon.core.weights import normalize_rows  # noqa: E402
 

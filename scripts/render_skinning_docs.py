@@ -25,7 +25,7 @@ import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from autorig_addon.blender.characters import load_character  # noqa: E402
-from autorig_addon.core.geometric_skinning import geometric_weights  # noqa: E402
+from autorig_addon.core.skinning.geometric import geometric_weights  # noqa: E402
 from docs_render import bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render  # noqa: E402
 
 CHARACTERS = os.path.join(REPO, "..", "shared", "data", "characters")

@@ -32,8 +32,8 @@ from autorig_addon.blender.convert import (  # noqa: E402
     write_status_attribute,
     write_weights,
 )
-from autorig_addon.core.closest_point import TriangleMeshQuery  # noqa: E402
-from autorig_addon.core.transfer import transfer_weights  # noqa: E402
+from autorig_addon.core.geometry.closest_point import TriangleMeshQuery  # noqa: E402
+from autorig_addon.core.transfer.transfer import transfer_weights  # noqa: E402
 from autorig_addon.core.types import Weights  # noqa: E402
 from autorig_addon.core.weights import normalize_rows  # noqa: E402
 from docs_render import duplicate, heat_colors, render, save_side_by_side, set_colors, set_pose, setup_render  # noqa: E402

@@ -1,6 +1,6 @@
 import numpy as np
 
-from autorig_addon.core.closest_point import TriangleMeshQuery, closest_points_on_triangles
+from autorig_addon.core.geometry.closest_point import TriangleMeshQuery, closest_points_on_triangles
 from geometry_fixtures import cylinder, grid
 
 

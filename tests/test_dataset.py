@@ -6,8 +6,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from autorig_addon.core import dataset
-from autorig_addon.core.dataset import (
+from autorig_addon.core.dataset import dataset
+from autorig_addon.core.dataset.dataset import (
     FACING_AS_NAMED,
     FACING_TURNED,
     FACING_UNKNOWN,

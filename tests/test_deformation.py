@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from autorig_addon.core.deformation import (
+from autorig_addon.core.evaluation.deformation import (
     axis_angle_matrices,
     character_size,
     deformation_error,

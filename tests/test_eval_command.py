@@ -10,10 +10,10 @@ import pytest
 
 from autorig_addon import eval_command
 from autorig_addon.blender import scene_io
-from autorig_addon.core.deformation import unique_edges
+from autorig_addon.core.evaluation.deformation import unique_edges
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.rignet_format import write_rignet_rig
-from autorig_addon.core.skin_metrics import evaluate_transfer
+from autorig_addon.core.io.rignet_rig import write_rignet_rig
+from autorig_addon.core.evaluation.skin_metrics import evaluate_transfer
 from autorig_addon.core.types import Skeleton, Weights
 from blender_fixtures import (
     BODY_HEIGHT,

@@ -6,11 +6,11 @@ from geometry_fixtures import cylinder
 from test_voxelize import box_mesh
 
 from autorig_addon.core.errors import Cancelled, InputError
-from autorig_addon.core.geometric_skinning import (
+from autorig_addon.core.skinning.geometric import (
     geometric_weights,
     heat_diffusion_weights,
 )
-from autorig_addon.core.mesh_ops import smooth_over_edges, weld_vertices
+from autorig_addon.core.geometry.mesh_ops import smooth_over_edges, weld_vertices
 from autorig_addon.core.types import Mesh, Skeleton
 
 
@@ -164,7 +164,7 @@ def test_bad_input_is_rejected_with_a_clear_message():
 
 
 def test_a_vertex_sees_its_nearest_bone_only_when_the_path_is_straight():
-    from autorig_addon.core.geometric_skinning import sees_nearest_bone
+    from autorig_addon.core.skinning.geometric import sees_nearest_bone
 
     vertices = np.array([[0.0, 1.0, 0.0], [0.0, 2.0, 0.0]])
     heads, tails = np.array([[-1.0, 0.0, 0.0]]), np.array([[1.0, 0.0, 0.0]])

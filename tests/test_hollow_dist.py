@@ -7,9 +7,9 @@ from test_volumetric_geodesic import vertex_index
 from test_voxelize import box_mesh, plain_grid
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.hollow_dist import build_hollow_graph, hollow_distances
+from autorig_addon.core.distances.hollow_dist import build_hollow_graph, hollow_distances
 from autorig_addon.core.types import Mesh
-from autorig_addon.core.voxelize import (
+from autorig_addon.core.distances.voxelize import (
     STAIRCASE_RATIO,
     bone_node_distances,
     combine_vertex_distances,

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from autorig_addon.core.mesh_ops import (
+from autorig_addon.core.geometry.mesh_ops import (
     connected_component_labels,
     cotangent_laplacian,
     edges,
@@ -82,7 +82,7 @@ def test_vertex_normals_of_closed_cylinder_point_outwards():
 
 
 def test_smoothing_moves_only_the_chosen_rows():
-    from autorig_addon.core.mesh_ops import smooth_over_edges
+    from autorig_addon.core.geometry.mesh_ops import smooth_over_edges
 
     mesh = grid(2, 2)  # one quad, two triangles
     values = np.array([[1.0], [0.0], [0.0], [0.0]])

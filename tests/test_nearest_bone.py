@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from autorig_addon.core import nearest_bone
+from autorig_addon.core.skinning import nearest_bone
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.nearest_bone import closest_segments, nearest_bone_weights
+from autorig_addon.core.skinning.nearest_bone import closest_segments, nearest_bone_weights
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import cylinder, two_bone_skeleton
 

@@ -250,7 +250,7 @@ def test_linux_zip_contents(linux_zip):
     with zipfile.ZipFile(linux_zip) as archive:
         names = set(archive.namelist())
         manifest = tomllib.loads(archive.read("blender_manifest.toml").decode())
-    assert {"blender_manifest.toml", "__init__.py", "core/types.py", "core/rignet_format.py"} <= names
+    assert {"blender_manifest.toml", "__init__.py", "core/types.py", "core/io/rignet_rig.py"} <= names
     assert not any("__pycache__" in name or name.endswith(".pyc") for name in names)
     wheels = sorted(name for name in names if name.startswith("wheels/"))
     assert [w.split("/")[1].split("-")[0] for w in wheels] == ["mpmath", "scipy", "sympy", "torch", "typing_extensions"]

@@ -7,10 +7,10 @@ import os
 import numpy as np
 import pytest
 
-from autorig_addon.core import procedural
-from autorig_addon.core.closest_point import closest_points_on_triangles
+from autorig_addon.core.procedural import generator as procedural
+from autorig_addon.core.geometry.closest_point import closest_points_on_triangles
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.procedural import (
+from autorig_addon.core.procedural.generator import (
     KINDS,
     PART_CLOTH,
     PART_DRIVEN,

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.rignet_format import read_rignet_rig, rignet_rig_text, write_rignet_rig
+from autorig_addon.core.io.rignet_rig import read_rignet_rig, rignet_rig_text, write_rignet_rig
 from autorig_addon.core.types import Skeleton, Weights
 
 # Hierarchy lines deliberately children-before-parents and joints out of

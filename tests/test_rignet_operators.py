@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.rignet_format import read_rignet_rig
+from autorig_addon.core.io.rignet_rig import read_rignet_rig
 from autorig_addon.core.types import Skeleton
 from blender_fixtures import build_rig_scene, group_weights, select_only
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.skeleton_metrics import (
+from autorig_addon.core.evaluation.skeleton_metrics import (
     bone_segments,
     chamfer_b2b,
     chamfer_j2b,

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.transfer import (
+from autorig_addon.core.transfer.transfer import (
     TransferOptions,
     VertexStatus,
     inpaint_weights,

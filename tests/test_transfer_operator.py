@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import convert
-from autorig_addon.blender.operators_transfer import scene_defaults
-from autorig_addon.core.transfer import VertexStatus
+from autorig_addon.blender.operators.transfer import scene_defaults
+from autorig_addon.core.transfer.transfer import VertexStatus
 from blender_fixtures import (
     BLEND_END,
     BLEND_START,
@@ -329,8 +329,8 @@ class RecordingLayout:
 def test_transfer_panel_draws_every_setting_and_the_buttons(rig):
     from types import SimpleNamespace
 
-    from autorig_addon.blender.panels import VIEW3D_PT_autorig_transfer
-    from autorig_addon.blender.properties import TRANSFER_OPTION_NAMES
+    from autorig_addon.blender.ui.panels import VIEW3D_PT_autorig_transfer
+    from autorig_addon.blender.ui.properties import TRANSFER_OPTION_NAMES
 
     select_only([rig.body, rig.sleeve], active=rig.sleeve)
     bpy.context.scene.autorig.source = rig.body
@@ -347,8 +347,8 @@ def test_transfer_panel_draws_every_setting_and_the_buttons(rig):
 def test_skin_panel_draws_every_skin_setting_and_the_button(rig):
     from types import SimpleNamespace
 
-    from autorig_addon.blender.panels import VIEW3D_PT_autorig_skin
-    from autorig_addon.blender.properties import SKIN_OPTION_NAMES
+    from autorig_addon.blender.ui.panels import VIEW3D_PT_autorig_skin
+    from autorig_addon.blender.ui.properties import SKIN_OPTION_NAMES
 
     select_only([rig.armature, rig.sleeve], active=rig.armature)
     log = []

@@ -7,12 +7,12 @@ from test_voxelize import box_mesh
 
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.types import Mesh
-from autorig_addon.core.volumetric_geodesic import (
+from autorig_addon.core.distances.volumetric_geodesic import (
     OUTSIDE_JUMP_PENALTY,
     UNREACHABLE_PENALTY,
     volumetric_geodesic_distances,
 )
-from autorig_addon.core.voxelize import point_segment_distances
+from autorig_addon.core.distances.voxelize import point_segment_distances
 
 
 def vertex_index(mesh: Mesh, point) -> int:

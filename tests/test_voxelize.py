@@ -8,7 +8,7 @@ from scipy import ndimage
 
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.types import Mesh
-from autorig_addon.core.voxelize import (
+from autorig_addon.core.distances.voxelize import (
     BoneGraph,
     VoxelGrid,
     _triangle_touches_cell,

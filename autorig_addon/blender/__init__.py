@@ -13,7 +13,7 @@ import bpy
 
 #: Modules with a ``classes`` tuple, in registration order (property groups
 #: before the operators and panels that use them).
-_MODULE_NAMES = ("properties", "operators_transfer", "operators_skin", "operators_rignet", "panels")
+_MODULE_NAMES = ("ui.properties", "operators.transfer", "operators.skin", "operators.rignet", "ui.panels")
 
 
 def _modules():
@@ -29,7 +29,7 @@ def register() -> None:
     for cls in _all_classes():
         if not getattr(cls, "is_registered", False):
             bpy.utils.register_class(cls)
-    from .properties import register_scene_properties
+    from .ui.properties import register_scene_properties
 
     register_scene_properties()
     for module in _modules():
@@ -40,7 +40,7 @@ def register() -> None:
 
 def unregister() -> None:
     """Undo :func:`register`; calling it when not registered is harmless."""
-    from .properties import unregister_scene_properties
+    from .ui.properties import unregister_scene_properties
 
     unregister_scene_properties()
     for module in reversed(_modules()):

@@ -42,10 +42,10 @@ from urllib.parse import quote, unquote
 import bpy
 import numpy as np
 
-from ..core import dataset
-from ..core.deformation import character_size
+from ..core.dataset import dataset
+from ..core.evaluation.deformation import character_size
 from ..core.errors import InputError
-from ..core.mesh_ops import weld_vertices
+from ..core.geometry.mesh_ops import weld_vertices
 from ..core.progress import ProgressCallback
 from ..core.types import Mesh, Skeleton, Weights
 from ..core.weights import INFLUENCE_EPSILON, normalize_rows

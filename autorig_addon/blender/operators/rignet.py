@@ -15,10 +15,10 @@ import numpy as np
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..core.errors import InputError
-from ..core.rignet_format import read_rignet_rig, write_rignet_rig
-from . import convert
-from .armature_builder import build_armature
+from ...core.errors import InputError
+from ...core.io.rignet_rig import read_rignet_rig, write_rignet_rig
+from .. import convert
+from ..armature_builder import build_armature
 
 
 def import_rignet_rig(context, filepath: str, mesh_obj=None):

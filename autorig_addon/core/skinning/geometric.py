@@ -45,20 +45,20 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from .errors import InputError
-from .hollow_dist import hollow_distances
-from .mesh_ops import (
+from ..errors import InputError
+from ..distances.hollow_dist import hollow_distances
+from ..geometry.mesh_ops import (
     connected_component_labels,
     cotangent_laplacian,
     smooth_over_edges,
     voronoi_mass,
     weld_vertices,
 )
-from .progress import ProgressCallback, report, sub_progress
-from .types import Mesh, Skeleton, Weights
-from .volumetric_geodesic import volumetric_geodesic_distances
-from .voxelize import DEFAULT_RESOLUTION, paired_point_segment_distances
-from .weights import empty_rows, limit_influences, prune_small
+from ..progress import ProgressCallback, report, sub_progress
+from ..types import Mesh, Skeleton, Weights
+from ..distances.volumetric_geodesic import volumetric_geodesic_distances
+from ..distances.voxelize import DEFAULT_RESOLUTION, paired_point_segment_distances
+from ..weights import empty_rows, limit_influences, prune_small
 
 #: Distance kinds: "geodesic" (through the solid; needs closed parts for an
 #: interior, else paths follow the surface) and "hollow" (HollowDist,

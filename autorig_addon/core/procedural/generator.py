@@ -36,10 +36,10 @@ from typing import Sequence
 import numpy as np
 from scipy.spatial import cKDTree
 
-from . import procedural_templates as templates
-from .closest_point import closest_points_on_triangles
-from .errors import InputError
-from .types import Mesh, Skeleton, Weights
+from . import templates as templates
+from ..geometry.closest_point import closest_points_on_triangles
+from ..errors import InputError
+from ..types import Mesh, Skeleton, Weights
 
 #: Character kinds :func:`generate_character` can make.
 KINDS = ("biped", "quadruped", "multileg", "winged", "tailed", "long_chain", "fish", "prop")

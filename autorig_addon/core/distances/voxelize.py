@@ -43,9 +43,9 @@ import scipy.sparse as sp
 from scipy import ndimage
 from scipy.sparse.csgraph import dijkstra
 
-from .errors import InputError
-from .progress import ProgressCallback, report, sub_progress
-from .types import Mesh
+from ..errors import InputError
+from ..progress import ProgressCallback, report, sub_progress
+from ..types import Mesh
 
 #: Cells along the longest side of the mesh bounding box (both RigNet and
 #: HeterSkinNet use 88).

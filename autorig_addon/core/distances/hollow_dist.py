@@ -57,8 +57,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .progress import ProgressCallback, report, sub_progress
-from .types import Mesh
+from ..progress import ProgressCallback, report, sub_progress
+from ..types import Mesh
 from .voxelize import (
     DEFAULT_RESOLUTION,
     NEIGHBOUR_OFFSETS,

@@ -46,10 +46,10 @@ from typing import Callable, Iterable, NamedTuple, Optional, Sequence
 
 import numpy as np
 
-from .errors import InputError
-from .progress import ProgressCallback, report
-from .types import Mesh, Skeleton, Weights
-from .weights import normalize_rows
+from ..errors import InputError
+from ..progress import ProgressCallback, report
+from ..types import Mesh, Skeleton, Weights
+from ..weights import normalize_rows
 
 #: Environment variable naming the cache root (samples go to ``<root>/samples``).
 CACHE_ENVIRONMENT_VARIABLE = "AUTORIG_CACHE"

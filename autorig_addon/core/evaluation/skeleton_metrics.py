@@ -30,8 +30,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .errors import InputError
-from .types import Skeleton
+from ..errors import InputError
+from ..types import Skeleton
 
 #: Joints closer than this share of the character size are one joint.
 COINCIDENT_JOINT_FRACTION = 1e-3

@@ -30,8 +30,8 @@ from typing import Optional, Union
 
 import numpy as np
 
-from .errors import InputError
-from .types import Skeleton, Weights
+from ..errors import InputError
+from ..types import Skeleton, Weights
 
 #: Keyword of each record type.
 JOINT_KEYWORD = "joints"

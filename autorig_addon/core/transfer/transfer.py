@@ -28,9 +28,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from .closest_point import TriangleMeshQuery
-from .errors import InputError
-from .mesh_ops import (
+from ..geometry.closest_point import TriangleMeshQuery
+from ..errors import InputError
+from ..geometry.mesh_ops import (
     connected_component_labels,
     cotangent_laplacian,
     non_manifold_edge_count,
@@ -39,9 +39,9 @@ from .mesh_ops import (
     voronoi_mass,
     weld_vertices,
 )
-from .progress import ProgressCallback, report
-from .types import Mesh, Weights
-from .weights import check_weights, limit_influences, normalize_rows, prune_small
+from ..progress import ProgressCallback, report
+from ..types import Mesh, Weights
+from ..weights import check_weights, limit_influences, normalize_rows, prune_small
 
 #: Default match distance, as a fraction of the target's bounding-box diagonal (paper: 0.05).
 DEFAULT_DISTANCE_FRACTION = 0.05

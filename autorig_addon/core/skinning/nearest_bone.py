@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import InputError
-from .types import Mesh, Skeleton, Weights
+from ..errors import InputError
+from ..types import Mesh, Skeleton, Weights
 
 #: Point-segment distances are computed for this many vertices at a time,
 #: so memory stays at ``POINT_CHUNK * bones`` floats (a few MB) on any mesh.

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import InputError
-from .types import Skeleton, Weights
+from ..errors import InputError
+from ..types import Skeleton, Weights
 
 #: Number of random poses of the deformation error (RigNet's protocol).
 DEFAULT_POSE_COUNT = 10

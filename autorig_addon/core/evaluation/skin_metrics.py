@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from .deformation import character_size, deform_weight_matrix, deformation_error, posed_edge_stretch, random_poses
-from .errors import InputError
-from .types import Skeleton
-from .weights import INFLUENCE_EPSILON
+from ..errors import InputError
+from ..types import Skeleton
+from ..weights import INFLUENCE_EPSILON
 
 
 def skin_l1(pred: np.ndarray, ref: np.ndarray) -> float:

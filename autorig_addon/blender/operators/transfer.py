@@ -17,14 +17,14 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
-from ..core import transfer
-from ..core.errors import Cancelled, InputError
-from ..core.progress import ProgressCallback, report, sub_progress
-from ..core.types import Mesh, Weights
-from ..core.weights import limit_influences, mix_weights, normalize_rows, prune_small
-from . import convert
-from .progress import blender_progress
-from .properties import GROUP_MEMBER_THRESHOLD, TRANSFER_OPTION_NAMES, TransferOptionProperties
+from ...core.transfer import transfer
+from ...core.errors import Cancelled, InputError
+from ...core.progress import ProgressCallback, report, sub_progress
+from ...core.types import Mesh, Weights
+from ...core.weights import limit_influences, mix_weights, normalize_rows, prune_small
+from .. import convert
+from ..progress import blender_progress
+from ..ui.properties import GROUP_MEMBER_THRESHOLD, TRANSFER_OPTION_NAMES, TransferOptionProperties
 
 #: How a transfer combines with existing vertex groups (see properties.REPLACE_MODE_ITEMS).
 REPLACE_MODES = ("REPLACE", "MIX", "REPLACE_ALL")
@@ -61,7 +61,7 @@ class TransferSettings:
     mix_factor: float = 1.0
 
     def core_options(self):
-        from ..core.transfer import TransferOptions
+        from ...core.transfer.transfer import TransferOptions
 
         return TransferOptions(
             distance_fraction=float(self.distance_fraction),
@@ -299,7 +299,7 @@ def needs_existing_weights(settings: TransferSettings, transferred_count: int, b
 
 
 def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallback | None) -> TargetOutcome:
-    from ..core.transfer import transfer_weights
+    from ...core.transfer.transfer import transfer_weights
 
     settings = plan.settings
     target_mesh = convert.read_mesh([target], depsgraph)

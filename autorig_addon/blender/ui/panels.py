@@ -2,8 +2,8 @@
 
 import bpy
 
-from .operators_skin import AUTORIG_OT_skin_weights
-from .operators_transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
+from ..operators.skin import AUTORIG_OT_skin_weights
+from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
 
 #: Sidebar tab the add-on's panels live in.
 SIDEBAR_CATEGORY = "AutoRig"

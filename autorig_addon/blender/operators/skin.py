@@ -21,15 +21,15 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
-from ..core import geometric_skinning as skinning
-from ..core.errors import Cancelled, InputError
-from ..core.progress import ProgressCallback
-from ..core.types import Mesh, Skeleton, Weights
-from ..core.voxelize import DEFAULT_RESOLUTION
-from . import convert
-from .progress import blender_progress
-from .scene_io import find_object
-from .properties import SKIN_OPTION_NAMES, SkinOptionProperties
+from ...core.skinning import geometric as skinning
+from ...core.errors import Cancelled, InputError
+from ...core.progress import ProgressCallback
+from ...core.types import Mesh, Skeleton, Weights
+from ...core.distances.voxelize import DEFAULT_RESOLUTION
+from .. import convert
+from ..progress import blender_progress
+from ..scene_io import find_object
+from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
 
 #: When even the deform bone point nearest the mesh's bounding box is
 #: farther than this many mesh diagonals from it, the armature was not
@@ -155,7 +155,7 @@ def run_skin(armature, meshes: list, settings: SkinSettings, depsgraph, progress
 def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
     """The armature and meshes to skin: named ones, else the selection
     (the active or selected armature and the selected meshes)."""
-    from .operators_transfer import split_names
+    from .transfer import split_names
 
     if armature_name:
         armature = find_object(armature_name, "ARMATURE")

@@ -10,12 +10,12 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from ..core.transfer import (  # the transfer defaults live with the algorithm
+from ...core.transfer.transfer import (  # the transfer defaults live with the algorithm
     DEFAULT_DISTANCE_FRACTION,
     DEFAULT_SMOOTHING_ITERATIONS,
     DEFAULT_SMOOTHING_STRENGTH,
 )
-from ..core.transfer import DEFAULT_MAX_NORMAL_ANGLE as DEFAULT_MAX_NORMAL_ANGLE_DEGREES
+from ...core.transfer.transfer import DEFAULT_MAX_NORMAL_ANGLE as DEFAULT_MAX_NORMAL_ANGLE_DEGREES
 
 #: Default absolute match distance, metres, used only when "Absolute Distance" is on.
 DEFAULT_MAX_DISTANCE = 0.05
@@ -138,14 +138,14 @@ TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
 
 
 
-from ..core.geometric_skinning import (  # noqa: E402  (defaults shared with the core)
+from ...core.skinning.geometric import (  # noqa: E402  (defaults shared with the core)
     DEFAULT_FALLOFF,
     DEFAULT_METHOD,
     DEFAULT_MAX_INFLUENCES,
 )
-from ..core.geometric_skinning import DEFAULT_SMOOTHING_ITERATIONS as DEFAULT_SKIN_SMOOTHING_ITERATIONS  # noqa: E402
-from ..core.geometric_skinning import DEFAULT_SMOOTHING_STRENGTH as DEFAULT_SKIN_SMOOTHING_STRENGTH  # noqa: E402
-from ..core.voxelize import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION  # noqa: E402
+from ...core.skinning.geometric import DEFAULT_SMOOTHING_ITERATIONS as DEFAULT_SKIN_SMOOTHING_ITERATIONS  # noqa: E402
+from ...core.skinning.geometric import DEFAULT_SMOOTHING_STRENGTH as DEFAULT_SKIN_SMOOTHING_STRENGTH  # noqa: E402
+from ...core.distances.voxelize import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION  # noqa: E402
 
 SKIN_DISTANCE_ITEMS = (
     ("GEODESIC", "Volumetric Geodesic",

@@ -43,8 +43,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from .progress import ProgressCallback, report, sub_progress
-from .types import Mesh
+from ..progress import ProgressCallback, report, sub_progress
+from ..types import Mesh
 from .voxelize import (
     DEFAULT_RESOLUTION,
     BoneGraph,
