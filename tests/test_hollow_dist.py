@@ -8,12 +8,12 @@ from test_voxelize import box_mesh, plain_grid
 
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.distances.hollow_dist import build_hollow_graph, hollow_distances
+from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.types import Mesh
 from autorig_addon.core.distances.voxelize import (
     STAIRCASE_RATIO,
     bone_node_distances,
     combine_vertex_distances,
-    point_segment_distances,
     vertex_cell_candidates,
 )
 

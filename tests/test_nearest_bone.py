@@ -3,9 +3,8 @@
 import numpy as np
 import pytest
 
-from autorig_addon.core.skinning import nearest_bone
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.skinning.nearest_bone import closest_segments, nearest_bone_weights
+from autorig_addon.core.skinning.nearest_bone import nearest_bone_weights
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import cylinder, two_bone_skeleton
 
@@ -39,31 +38,6 @@ def test_non_deform_bones_get_no_column():
     assert np.all(weights.matrix[z < 0.45, 0] == 1.0)
 
 
-def test_distances_to_segments_by_hand():
-    starts = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
-    ends = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])  # the second is a point
-    points = np.array([[0.5, 0.3, 0.0], [-1.0, 0.0, 0.0], [2.0, 0.0, 0.4], [1.6, 0.0, 0.0]])
-    index, distance = closest_segments(points, starts, ends)
-    np.testing.assert_array_equal(index, [0, 0, 1, 1])
-    np.testing.assert_allclose(distance, [0.3, 1.0, 0.4, 0.4])
-
-
-def test_chunking_gives_the_same_answer(monkeypatch):
-    rng = np.random.default_rng(3)
-    points = rng.normal(size=(1000, 3))
-    starts, ends = rng.normal(size=(7, 3)), rng.normal(size=(7, 3))
-    whole_index, whole_distance = closest_segments(points, starts, ends)
-    monkeypatch.setattr(nearest_bone, "POINT_CHUNK", 64)
-    chunk_index, chunk_distance = closest_segments(points, starts, ends)
-    np.testing.assert_array_equal(whole_index, chunk_index)
-    np.testing.assert_allclose(whole_distance, chunk_distance)
-    # Brute force: sample every segment densely; the closest sample is within one step.
-    t = np.linspace(0.0, 1.0, 2001)[:, None, None]
-    samples = (starts[None] + t * (ends - starts)[None]).reshape(-1, 3)
-    brute = np.linalg.norm(points[:, None, :] - samples[None], axis=2).min(axis=1)
-    step = np.linalg.norm(ends - starts, axis=1).max() / 2000
-    assert np.all(whole_distance <= brute + 1e-12)
-    assert np.all(brute - whole_distance <= step)
 
 
 def test_skeleton_without_deform_bones_is_an_input_error():

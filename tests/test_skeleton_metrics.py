@@ -14,7 +14,6 @@ from autorig_addon.core.evaluation.skeleton_metrics import (
     joint_iou_precision_recall,
     match_joints,
     merge_coincident_joints,
-    point_segment_distances,
     sample_bones,
     tree_edit_distance,
 )
@@ -71,12 +70,6 @@ def test_j2b_single_joint_against_bone():
     assert chamfer_j2b(pred, ref) == pytest.approx((0.5 + np.sqrt(1.25)) / 2.0)
     assert chamfer_j2b(pred, ref, size=4.0) == pytest.approx((0.5 + np.sqrt(1.25)) / 8.0)
 
-
-def test_point_segment_distance_clamps_to_ends():
-    segments = np.array([[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]], [[5.0, 5.0, 5.0], [5.0, 5.0, 5.0]]])
-    distances = point_segment_distances([[3.0, 0.0, 0.0], [1.0, 0.3, 0.4], [5.0, 5.0, 6.0]], segments)
-    np.testing.assert_allclose(distances[:, 0], [1.0, 0.5, np.linalg.norm([3.0, 5.0, 6.0])])
-    np.testing.assert_allclose(distances[2, 1], 1.0)
 
 
 def test_bone_segments_run_parent_to_child_and_keep_lone_joints():

@@ -12,7 +12,7 @@ from autorig_addon.core.distances.volumetric_geodesic import (
     UNREACHABLE_PENALTY,
     volumetric_geodesic_distances,
 )
-from autorig_addon.core.distances.voxelize import point_segment_distances
+from autorig_addon.core.geometry.segments import point_segment_distances
 
 
 def vertex_index(mesh: Mesh, point) -> int:

@@ -18,7 +18,6 @@ from autorig_addon.core.distances.voxelize import (
     fill_interior,
     merge_cells,
     neighbour_node_pairs,
-    point_segment_distances,
     segment_cells,
     vertex_cell_candidates,
     voxelize_surface,
@@ -192,12 +191,6 @@ def test_segment_cells_lists_the_cells_a_bone_crosses():
     second = cells[bone == 1]
     np.testing.assert_array_equal(second[np.argsort(second[:, 0])], [[0, 2, 2], [1, 2, 2]])
 
-
-def test_point_segment_distances():
-    heads = np.array([[0.0, 0, 0], [0, 0, 0]])
-    tails = np.array([[2.0, 0, 0], [0, 0, 0]])  # the second bone has no length
-    points = np.array([[1.0, 3, 0], [-3, 4, 0], [5, 0, 0]])
-    np.testing.assert_allclose(point_segment_distances(points, heads, tails), [[3, np.sqrt(10)], [5, 5], [3, 5]])
 
 
 # --------------------------------------------------------------------------

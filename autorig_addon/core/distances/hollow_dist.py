@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.segments import paired_point_segment_distances, point_segment_distances
 from ..progress import ProgressCallback, report, sub_progress
 from ..types import Mesh
 from .voxelize import (
@@ -72,8 +73,6 @@ from .voxelize import (
     layer_cost_above,
     merge_cells,
     neighbour_node_pairs,
-    paired_point_segment_distances,
-    point_segment_distances,
     refine_in_sight,
     segment_cells,
     validate_bones,

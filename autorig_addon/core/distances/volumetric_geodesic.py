@@ -43,6 +43,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from ..geometry.segments import paired_point_segment_distances, point_segment_distances
 from ..progress import ProgressCallback, report, sub_progress
 from ..types import Mesh
 from .voxelize import (
@@ -56,8 +57,6 @@ from .voxelize import (
     fill_unreached,
     merge_cells,
     neighbour_node_pairs,
-    paired_point_segment_distances,
-    point_segment_distances,
     refine_in_sight,
     segment_cells,
     validate_bones,

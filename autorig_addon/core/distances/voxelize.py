@@ -44,6 +44,7 @@ from scipy import ndimage
 from scipy.sparse.csgraph import dijkstra
 
 from ..errors import InputError
+from ..geometry.segments import nearest_points_on_segments, point_segment_distances
 from ..progress import ProgressCallback, report, sub_progress
 from ..types import Mesh
 
@@ -70,8 +71,6 @@ MAX_BLOCK_CELLS = 8
 #: Memory for one batch of Dijkstra results (8 bytes per node per bone);
 #: bones are processed in batches that fit.
 DIJKSTRA_BATCH_BYTES = 64 << 20
-#: Memory for the temporaries of one chunk of point-to-segment distances.
-POINT_SEGMENT_CHUNK_BYTES = 64 << 20
 #: Graph paths are staircases of 26-neighbour steps, at most this many
 #: times the straight length (worst direction about (1, 0.41, 0.32)).
 STAIRCASE_RATIO = 1.13
@@ -385,44 +384,8 @@ def segment_cells(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) -> tupl
     return bone[first], cells[first]
 
 
-def paired_point_segment_distances(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
-    """(k,) float64 distance from ``points[i]`` to the segment ``heads[i]``-``tails[i]``.
-
-    Parameters
-    ----------
-    points, heads, tails : (k, 3) float64 arrays
-    """
-    relative = points - heads
-    direction = tails - heads
-    length_sq = np.einsum("ij,ij->i", direction, direction)
-    t = np.einsum("ij,ij->i", relative, direction) / np.where(length_sq > 0, length_sq, 1.0)
-    t = np.clip(t, 0.0, 1.0)
-    return np.linalg.norm(relative - t[:, None] * direction, axis=1)
 
 
-def point_segment_distances(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
-    """(k, b) float64 Euclidean distance from each point to each segment.
-
-    Parameters
-    ----------
-    points : (k, 3) float64 array
-    heads, tails : (b, 3) float64 arrays, segment ends (zero length allowed)
-
-    Works through the points in chunks so the (chunk, b, 3) temporaries stay
-    under :data:`POINT_SEGMENT_CHUNK_BYTES` however many points there are.
-    """
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    heads = np.asarray(heads, dtype=np.float64).reshape(-1, 3)
-    direction = np.asarray(tails, dtype=np.float64).reshape(-1, 3) - heads
-    length_sq = np.einsum("ij,ij->i", direction, direction)
-    safe_length_sq = np.where(length_sq > 0, length_sq, 1.0)
-    out = np.empty((len(points), len(heads)))
-    chunk = max(1, POINT_SEGMENT_CHUNK_BYTES // (24 * max(len(heads), 1)))
-    for start in range(0, len(points), chunk):
-        relative = points[start:start + chunk, None, :] - heads[None, :, :]  # (c, b, 3)
-        t = np.clip(np.einsum("kbi,bi->kb", relative, direction) / safe_length_sq, 0.0, 1.0)
-        out[start:start + chunk] = np.linalg.norm(relative - t[:, :, None] * direction[None, :, :], axis=2)
-    return out
 
 
 # --------------------------------------------------------------------------
@@ -818,7 +781,7 @@ def refine_in_sight(
     for start in range(0, len(vertices), rows_per_batch):
         rows = slice(start, min(start + rows_per_batch, len(vertices)))
         v = vertices[rows]
-        nearest = _nearest_on_segments(v, heads, tails)  # (r, b, 3)
+        nearest = nearest_points_on_segments(v, heads, tails)  # (r, b, 3)
         straight = np.linalg.norm(nearest - v[:, None, :], axis=2)
         current = refined[rows]
         candidate = (current > straight) & (current <= STAIRCASE_RATIO * straight + slack)
@@ -833,13 +796,6 @@ def refine_in_sight(
     return refined
 
 
-def _nearest_on_segments(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
-    """(k, b, 3) float64: nearest point of each segment to each point."""
-    direction = tails - heads
-    length_sq = np.einsum("ij,ij->i", direction, direction)
-    relative = points[:, None, :] - heads[None, :, :]
-    t = np.einsum("kbi,bi->kb", relative, direction) / np.where(length_sq > 0, length_sq, 1.0)
-    return heads[None, :, :] + np.clip(t, 0.0, 1.0)[:, :, None] * direction[None, :, :]
 
 
 def _walk_in_sight(

@@ -31,6 +31,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from ..geometry.segments import point_segment_distances
 from ..types import Skeleton
 
 #: Joints closer than this share of the character size are one joint.
@@ -187,8 +188,8 @@ def chamfer_j2b(pred: Skeleton, ref: Skeleton, size: float = 1.0) -> float:
     -------
     distance : float, in units of ``size``
     """
-    pred_to_ref = point_segment_distances(pred.joints, bone_segments(ref)).min(axis=1).mean()
-    ref_to_pred = point_segment_distances(ref.joints, bone_segments(pred)).min(axis=1).mean()
+    pred_to_ref = _joint_bone_distances(pred.joints, ref).min(axis=1).mean()
+    ref_to_pred = _joint_bone_distances(ref.joints, pred).min(axis=1).mean()
     return float(pred_to_ref + ref_to_pred) / 2.0 / _positive(size)
 
 
@@ -218,27 +219,6 @@ def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fracti
     return _symmetric_chamfer(pred_points, ref_points) / size
 
 
-def point_segment_distances(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """Euclidean distance from every point to every segment.
-
-    Parameters
-    ----------
-    points : (k, 3) float64 array
-    segments : (s, 2, 3) float64 array
-
-    Returns
-    -------
-    distances : (k, s) float64 array
-    """
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    segments = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 3)
-    start = segments[:, 0]
-    direction = segments[:, 1] - start
-    squared_length = np.einsum("sk,sk->s", direction, direction)
-    offset = points[:, None, :] - start[None, :, :]
-    projection = np.einsum("psk,sk->ps", offset, direction)
-    t = np.clip(np.divide(projection, squared_length, out=np.zeros_like(projection), where=squared_length > 0), 0.0, 1.0)
-    return np.linalg.norm(offset - t[:, :, None] * direction[None, :, :], axis=2)
 
 
 def match_joints(pred_joints: np.ndarray, ref_joints: np.ndarray, tolerance: float | None = None) -> np.ndarray:
@@ -532,6 +512,12 @@ def _deform_skeleton(skeleton: Skeleton, what: str) -> Skeleton:
     if deform.bone_count == 0:
         raise InputError(f"The {what} skeleton has no deform bones; mark the bones that move the mesh as Deform.")
     return deform
+
+
+def _joint_bone_distances(joints: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """(k, s) float64 distance from each joint to each bone segment of ``skeleton``."""
+    segments = bone_segments(skeleton)
+    return point_segment_distances(joints, segments[:, 0], segments[:, 1])
 
 
 def _symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray) -> float:

@@ -36,8 +36,9 @@ from typing import Sequence
 import numpy as np
 from scipy.spatial import cKDTree
 
-from . import templates as templates
+from . import templates
 from ..geometry.closest_point import closest_points_on_triangles
+from ..geometry.segments import polyline_arc_lengths
 from ..errors import InputError
 from ..types import Mesh, Skeleton, Weights
 
@@ -508,17 +509,6 @@ def _joint_blend_weights(arc, joint_arc, blend, with_parent, with_child):
     return np.concatenate(columns, axis=1)
 
 
-def _project_on_polyline(points, polyline):
-    """Arc length of the closest point of ``polyline`` (k+1, 3) to each of
-    ``points`` (n, 3); returns (n,) float64."""
-    starts, segments = polyline[:-1], np.diff(polyline, axis=0)
-    lengths_sq = np.maximum(np.einsum("ij,ij->i", segments, segments), 1e-300)
-    t = np.clip(np.einsum("nkj,kj->nk", points[:, None, :] - starts[None], segments) / lengths_sq, 0.0, 1.0)
-    closest = starts[None] + t[:, :, None] * segments[None]
-    best = np.argmin(np.linalg.norm(points[:, None, :] - closest, axis=2), axis=1)
-    arc = np.concatenate([[0.0], np.cumsum(np.sqrt(lengths_sq))])
-    rows = np.arange(len(points))
-    return arc[best] + t[rows, best] * np.sqrt(lengths_sq[best])
 
 
 # ---------------------------------------------------------------------------
@@ -1326,7 +1316,7 @@ def _add_skirt(ch, driven: bool):
     for k, (_, names) in enumerate(chains):
         share = np.where(lower % len(chains) == k, 1.0 - upper_share, 0.0) + np.where((lower + 1) % len(chains) == k, upper_share, 0.0)
         polyline = rig.path_points(names)
-        arc = _project_on_polyline(vertices, polyline)
+        arc = polyline_arc_lengths(vertices, polyline)
         joint_arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(polyline, axis=0), axis=1))])
         along = _joint_blend_weights(arc, joint_arc, ch.blend, True, False)
         blocks.append((["spine"] + names, along * share[:, None]))
@@ -1369,7 +1359,7 @@ def _add_cape(ch, driven: bool):
     names = _chain_names("cape", 3)
     for k, name in enumerate(names):
         rig.add(name, joints[k], joints[k + 1], "spine.003" if k == 0 else names[k - 1])
-    arc = _project_on_polyline(vertices, joints)
+    arc = polyline_arc_lengths(vertices, joints)
     joint_arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(joints, axis=0), axis=1))])
     weights = _joint_blend_weights(arc, joint_arc, ch.blend, True, False)
     ch.add_part(_Part("cape", PART_DRIVEN, False, vertices, triangles, tuple(["spine.003"] + names), weights))
@@ -1549,7 +1539,7 @@ def _add_membrane(ch, fingers, flank_polyline, torso_bones):
     torso_path = rig.path_points(torso_bones)
     torso_arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(torso_path, axis=0), axis=1))])
     column_points.append(flank)
-    column_weights.append((list(torso_bones), _joint_blend_weights(_project_on_polyline(flank, torso_path), torso_arc, ch.blend, False, False)))
+    column_weights.append((list(torso_bones), _joint_blend_weights(polyline_arc_lengths(flank, torso_path), torso_arc, ch.blend, False, False)))
     grid_points, grid_weights = [], []
     for c in range(len(column_points) - 1):
         shares = np.linspace(0.0, 1.0, MEMBRANE_STRIP_SAMPLES + 1)
@@ -2021,7 +2011,7 @@ class _FishBody:
         """Centre, unit radial direction and radius of the body surface seen
         from the spine point nearest ``point`` (towards ``point``, or along
         ``direction`` when given)."""
-        fraction = _project_on_polyline(point[None], self.path)[0] / self.length
+        fraction = polyline_arc_lengths(point[None], self.path)[0] / self.length
         centre = _points_at_fractions(self.path, np.array([fraction]))[0]
         step = 1e-3
         ahead = _points_at_fractions(self.path, np.clip(np.array([fraction - step, fraction + step]), 0, 1))

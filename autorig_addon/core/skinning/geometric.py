@@ -57,7 +57,8 @@ from ..geometry.mesh_ops import (
 from ..progress import ProgressCallback, report, sub_progress
 from ..types import Mesh, Skeleton, Weights
 from ..distances.volumetric_geodesic import volumetric_geodesic_distances
-from ..distances.voxelize import DEFAULT_RESOLUTION, paired_point_segment_distances
+from ..distances.voxelize import DEFAULT_RESOLUTION
+from ..geometry.segments import paired_point_segment_distances
 from ..weights import empty_rows, limit_influences, prune_small
 
 #: Distance kinds: "geodesic" (through the solid; needs closed parts for an
