@@ -61,7 +61,10 @@ DEFAULT_WHEEL_CACHE = os.path.join("~", ".cache", "autorig_addon", "wheels")
 
 
 class PackagingError(InputError):
-    """The build cannot go on; the message says why and what to do."""
+    """The build failed (pip could not fetch a wheel, Blender's builder
+    rejected the package, not a source checkout); the message says why and
+    what to do. The ``package`` subcommand exits 1 on it, not 2: the
+    command line was right."""
 
 
 @dataclass(frozen=True)
@@ -169,7 +172,7 @@ def build_packages(
         messages are included).
     """
     platforms = list(PLATFORM_TARGETS) if platforms is None else list(platforms)
-    _check_platforms(platforms)
+    check_platforms(platforms)
     if not MANIFEST_PATH.is_file():
         raise PackagingError(
             f"{MANIFEST_FILENAME} not found next to {ADDON_DIR}; build from a source checkout of the repository."
@@ -196,7 +199,7 @@ def wheel_requests(platform: str) -> list[WheelRequest]:
     here (the one the tests ran with), torch as :data:`PLATFORM_TARGETS`
     says, and torch's pure-Python import-time dependencies at their
     installed versions."""
-    _check_platforms([platform])
+    check_platforms([platform])
     pure_python = [WheelRequest(name, _installed_version(name)) for name in TORCH_PURE_PYTHON_DEPENDENCIES]
     return [WheelRequest("scipy", _installed_version("scipy")), PLATFORM_TARGETS[platform].torch, *pure_python]
 
@@ -356,7 +359,9 @@ def check_zip_wheels(zip_path: str, wheel_paths: Sequence[str]) -> None:
         )
 
 
-def _check_platforms(platforms: Sequence[str]) -> None:
+def check_platforms(platforms: Sequence[str]) -> None:
+    """Raise :class:`InputError` (not a :class:`PackagingError`: the request
+    is wrong, not the build) for no, unknown or repeated platform names."""
     if not platforms:
         raise InputError(f"No platform given; choose from {', '.join(PLATFORM_TARGETS)}.")
     unknown = [p for p in platforms if p not in PLATFORM_TARGETS]
@@ -430,6 +435,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("platforms", nargs="*", help=f"default: all of {', '.join(PLATFORM_TARGETS)}")
     parser.add_argument("--wheel-cache", default=None, help=f"download cache (default {DEFAULT_WHEEL_CACHE})")
     args = parser.parse_args(argv)
+    try:
+        check_platforms(args.platforms or list(PLATFORM_TARGETS))
+    except InputError as error:
+        parser.error(str(error))  # a bad argument: exit 2, like every usage error
     try:
         zips = build_packages(args.out_dir, args.platforms or None, args.wheel_cache,
                               progress=lambda fraction, message: print(f"[{fraction:4.0%}] {message}", flush=True))

@@ -29,17 +29,20 @@ sys.path.insert(0, REPO)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from memory import peak_rss_added  # noqa: E402
+from autorig_addon.core.distances.bone_distances import validate_bones, voxelize_covering_bones  # noqa: E402
+from autorig_addon.core.distances.cell_graph import bone_node_distances  # noqa: E402
 from autorig_addon.core.distances.hollow_dist import build_hollow_graph, refine_hollow_in_sight  # noqa: E402
+from autorig_addon.core.distances.interior import fill_interior  # noqa: E402
+from autorig_addon.core.distances.vertex_distances import combine_vertex_distances, vertex_cell_candidates  # noqa: E402
+from autorig_addon.core.distances.volumetric_geodesic import build_geodesic_graph, refine_geodesic_in_sight  # noqa: E402
 from autorig_addon.core.types import Mesh, Skeleton  # noqa: E402
-from autorig_addon.core.distances.volumetric_geodesic import build_geodesic_graph  # noqa: E402
-from autorig_addon.core.distances.voxelize import (  # noqa: E402
-    bone_node_distances,
-    combine_vertex_distances,
-    fill_interior,
-    refine_in_sight,
-    vertex_cell_candidates,
-    voxelize_surface,
-)
+
+#: Each distance kind's own stages (graph, line of sight); the others are shared
+#: (see ``autorig_addon.core.distances.bone_distances``).
+KINDS = {
+    "geodesic": (build_geodesic_graph, refine_geodesic_in_sight),
+    "hollow": (build_hollow_graph, refine_hollow_in_sight),
+}
 
 
 # --------------------------------------------------------------------------
@@ -155,16 +158,19 @@ def load_character(path: str) -> tuple[Mesh, Skeleton]:
 
 
 def run_stages(mesh: Mesh, heads, tails, resolution: int, kind: str) -> dict[str, float]:
-    """One full distance computation; seconds per stage."""
+    """One full distance computation, the stages of
+    ``core.distances.bone_distances.bone_distances`` called one by one; seconds per stage."""
+    build_graph, refine = KINDS[kind]
+    heads, tails = validate_bones(heads, tails)
     times = {}
     clock = time.perf_counter()
-    grid = voxelize_surface(mesh, resolution, cover_points=np.vstack([heads, tails]))
+    grid = voxelize_covering_bones(mesh, heads, tails, resolution)
     times["voxelise"] = time.perf_counter() - clock
     clock = time.perf_counter()
     grid = fill_interior(grid)
     times["fill"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    graph = (build_geodesic_graph if kind == "geodesic" else build_hollow_graph)(grid, heads, tails)
+    graph = build_graph(grid, heads, tails)
     times["graph"] = time.perf_counter() - clock
     clock = time.perf_counter()
     candidates, query_nodes = vertex_cell_candidates(graph, mesh.vertices)
@@ -172,10 +178,7 @@ def run_stages(mesh: Mesh, heads, tails, resolution: int, kind: str) -> dict[str
     times["paths"] = time.perf_counter() - clock
     clock = time.perf_counter()
     distances, layers = combine_vertex_distances(graph, mesh.vertices, candidates, query_nodes, node_distances)
-    if kind == "geodesic":
-        distances = refine_in_sight(grid, grid.occupied, distances, mesh.vertices, heads, tails)
-    else:
-        distances = refine_hollow_in_sight(grid, distances, layers, mesh.vertices, heads, tails)
+    refine(grid, distances, layers, mesh.vertices, heads, tails)
     times["lookup"] = time.perf_counter() - clock
     times["total"] = sum(times.values())
     times["nodes"] = graph.nodes.count

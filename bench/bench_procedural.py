@@ -17,7 +17,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from autorig_addon.core.procedural.generator import generate_character  # noqa: E402
+from autorig_addon.core.procedural import generate_character  # noqa: E402
 
 
 def main(argv=None) -> int:

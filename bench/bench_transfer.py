@@ -19,17 +19,13 @@ import statistics
 import sys
 import time
 
-import numpy as np
-
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, REPO)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.geometry.closest_point import TriangleMeshQuery  # noqa: E402
-from autorig_addon.core.transfer.transfer import transfer_weights  # noqa: E402
-from autorig_addon.core.types import Weights  # noqa: E402
-from autorig_addon.core.weights import normalize_rows  # noqa: E402
+from autorig_addon.core.transfer import transfer_weights  # noqa: E402
+from autorig_addon.core.transfer.matching import closest_point_weights  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 
@@ -49,12 +45,6 @@ def load_inputs(garment: str):
     return read_mesh([body], depsgraph), read_weights(body, bones), read_mesh([target], depsgraph)
 
 
-def closest_point_copy(source, source_weights: Weights, target) -> np.ndarray:
-    """The baseline: every target vertex takes the weights at its closest source point."""
-    surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    return normalize_rows(surface.interpolate(source.triangles, source_weights.matrix))
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--garment", default="male_casualsuit01")
@@ -67,7 +57,7 @@ def main(argv=None) -> int:
     totals, baseline = [], []
     for _ in range(args.repeat):
         start = time.perf_counter()
-        closest_point_copy(source, source_weights, target)
+        closest_point_weights(source, source_weights, target)
         baseline.append(time.perf_counter() - start)
         start = time.perf_counter()
         result = transfer_weights(source, source_weights, target)
@@ -75,7 +65,7 @@ def main(argv=None) -> int:
         for stage, seconds in result.timings.items():
             stage_times.setdefault(stage, []).append(seconds)
     memory = peak_rss_added(lambda: transfer_weights(source, source_weights, target))
-    baseline_memory = peak_rss_added(lambda: closest_point_copy(source, source_weights, target))
+    baseline_memory = peak_rss_added(lambda: closest_point_weights(source, source_weights, target))
 
     median_total, median_baseline = statistics.median(totals), statistics.median(baseline)
     print(f"Source: makehuman body, {source.vertex_count} vertices, {len(source.triangles)} triangles, "

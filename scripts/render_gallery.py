@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import bpy  # noqa: E402
 import mathutils  # noqa: E402
 
-from autorig_addon.core.procedural.generator import KINDS, generate_character  # noqa: E402
+from autorig_addon.core.procedural import KINDS, generate_character  # noqa: E402
 
 #: Image size in pixels (width per character, height).
 CELL_PIXELS = 200

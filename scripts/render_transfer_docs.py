@@ -24,14 +24,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
-from autorig_addon.blender.convert import (  # noqa: E402
-    deform_bone_names,
-    find_armature,
-    read_mesh,
-    read_weights,
-    write_status_attribute,
-    write_weights,
-)
+from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights  # noqa: E402
+from autorig_addon.blender.status_attribute import write_status_attribute  # noqa: E402
+from autorig_addon.blender.weight_writer import write_weights  # noqa: E402
 from autorig_addon.core.geometry.closest_point import TriangleMeshQuery  # noqa: E402
 from autorig_addon.core.transfer.transfer import transfer_weights  # noqa: E402
 from autorig_addon.core.types import Weights  # noqa: E402

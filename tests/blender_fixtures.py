@@ -196,3 +196,33 @@ def scene_state(objects) -> dict:
             entry["bones"] = [(b.name, b.use_deform) for b in obj.data.bones]
         state[obj.name] = entry
     return state
+
+
+class RecordingWindowManager:
+    """Stands in for bpy.types.WindowManager where a test calls an
+    operator's progress and timer code directly: records every call."""
+
+    def __init__(self):
+        self.calls = []
+
+    def progress_begin(self, low, high):
+        self.calls.append(("begin", low, high))
+
+    def progress_update(self, value):
+        self.calls.append(("update", value))
+
+    def progress_end(self):
+        self.calls.append(("end",))
+
+    def event_timer_remove(self, timer):
+        self.calls.append(("remove_timer", timer))
+
+
+class RecordingWorkspace:
+    """Stands in for bpy.types.WorkSpace: records each status text set (None clears it)."""
+
+    def __init__(self):
+        self.texts = []
+
+    def status_text_set(self, text):
+        self.texts.append(text)

@@ -17,6 +17,12 @@ for _path in (str(REPOSITORY_ROOT), str(TESTS_DIRECTORY)):
 
 
 @pytest.fixture(scope="session")
+def repository_root() -> Path:
+    """The repository's top folder (the working directory of subprocess tests)."""
+    return REPOSITORY_ROOT
+
+
+@pytest.fixture(scope="session")
 def registered_addon():
     """The add-on registered once for the whole session (bpy imported here)."""
     import bpy  # noqa: F401  (loads Blender before the add-on's modules)

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from autorig_addon.core.distances.grid import VoxelGrid
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 
 
@@ -55,3 +56,70 @@ def two_bone_weights(mesh: Mesh, height: float = 1.0, blend: float = 0.2) -> Wei
     z = mesh.vertices[:, 2]
     upper = np.clip((z - (height / 2 - blend / 2)) / blend, 0.0, 1.0)
     return Weights(np.stack([1 - upper, upper], axis=1), ("lower", "upper"))
+
+
+def box_mesh(low, high, spacing: float) -> Mesh:
+    """Closed axis-aligned box whose faces are grids of about ``spacing``,
+    outward normals (faces are not welded to each other; the surface is
+    still closed)."""
+    low, high = np.asarray(low, float), np.asarray(high, float)
+    vertices, triangles = [], []
+    for axis in range(3):
+        u, w = (axis + 1) % 3, (axis + 2) % 3
+        nu = max(1, int(np.ceil((high[u] - low[u]) / spacing)))
+        nw = max(1, int(np.ceil((high[w] - low[w]) / spacing)))
+        su, sw = np.meshgrid(np.linspace(low[u], high[u], nu + 1), np.linspace(low[w], high[w], nw + 1), indexing="ij")
+        for level, flip in ((low[axis], True), (high[axis], False)):
+            grid_points = np.zeros((su.size, 3))
+            grid_points[:, axis], grid_points[:, u], grid_points[:, w] = level, su.ravel(), sw.ravel()
+            index = np.arange(su.size).reshape(su.shape) + sum(len(v) for v in vertices)
+            a, b = index[:-1, :-1].ravel(), index[1:, :-1].ravel()
+            c, d = index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+            faces = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+            triangles.append(faces[:, ::-1] if flip else faces)
+            vertices.append(grid_points)
+    return Mesh(np.concatenate(vertices), np.concatenate(triangles))
+
+
+def plain_grid(shape, cell_size: float = 1.0, surface=None, inside=None) -> VoxelGrid:
+    """A voxel grid with its origin at 0 and the given masks (default all False)."""
+    empty = np.zeros(shape, dtype=bool)
+    return VoxelGrid(
+        np.zeros(3), cell_size, tuple(shape),
+        empty.copy() if surface is None else surface,
+        empty.copy() if inside is None else inside,
+    )
+
+
+def vertex_index(mesh: Mesh, point) -> int:
+    """Index of the vertex of ``mesh`` at ``point`` (which must be one)."""
+    index = int(np.argmin(np.linalg.norm(mesh.vertices - np.asarray(point, float), axis=1)))
+    assert np.allclose(mesh.vertices[index], point), "the fixture has no vertex there"
+    return index
+
+
+def body_with_hat():
+    """A closed cylinder body (r 0.2, z in [0, 1]) with two bones up its axis,
+    and a box hat 0.15 above its top that touches nothing.
+
+    Returns
+    -------
+    mesh : Mesh, the body's vertices first
+    hat_vertices : (k,) int array, the hat's rows of ``mesh``
+    heads, tails : (2, 3) float arrays: the lower bone z 0.05 to 0.6, the upper 0.6 to 0.95
+    """
+    body = cylinder(radius=0.2, height=1.0, segments=32, rings=21)
+    hat = box_mesh([-0.15, -0.15, 1.1], [0.15, 0.15, 1.3], 0.05)
+    mesh = Mesh.concatenate([body, hat])
+    heads = np.array([[0, 0, 0.05], [0, 0, 0.6]])
+    tails = np.array([[0, 0, 0.6], [0, 0, 0.95]])
+    return mesh, np.arange(body.vertex_count, mesh.vertex_count), heads, tails
+
+
+#: (heads, tails, exact message) of bones every vertex-to-bone distance refuses.
+BAD_BONES = [
+    (np.zeros((0, 3)), np.zeros((0, 3)), "No bones were given; add deforming bones to the armature."),
+    ([[np.nan, 0, 0]], [[0, 0, 1]], "A bone has a NaN or infinite position; fix the armature first."),
+    ([[0, 0, 0]], [[0, 0, np.inf]], "A bone has a NaN or infinite position; fix the armature first."),
+    (np.zeros((2, 3)), np.ones((1, 3)), "Every bone needs one head and one tail."),
+]

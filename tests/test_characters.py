@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import characters, scene_io
-from autorig_addon.core.dataset import dataset
+from autorig_addon.core import dataset
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.types import Mesh
 from blender_fixtures import (

@@ -1,18 +1,44 @@
 """The command line (python -m autorig_addon), in process and as a subprocess."""
 
+import io
 import json
+import math
 import subprocess
 import sys
-import types
 
 import bpy
 import numpy as np
 import pytest
 
-from autorig_addon import cli
+from autorig_addon import packaging
 from autorig_addon.blender import convert
-from blender_fixtures import LOWER_BONE, UPPER_BONE, build_rig_scene, local_positions, mesh_object, reset_scene
-from conftest import REPOSITORY_ROOT
+from autorig_addon.blender.operators.transfer import TransferSettings
+from autorig_addon.cli import transfer as cli_transfer
+from autorig_addon.cli.batch import TextProgress, output_paths
+from autorig_addon.cli.main import SUBCOMMANDS, arguments_from_sys_argv, build_parser, main
+from autorig_addon.core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
+from autorig_addon.core.geometry.smoothing import MAX_SMOOTHING_ITERATIONS
+from autorig_addon.core.skinning import geometric as skinning
+from autorig_addon.core.transfer import options as transfer_options
+from autorig_addon.core.transfer.combine import MIX, REPLACE_ALL
+from autorig_addon.core.transfer.options import TransferOptions
+from autorig_addon.core.weights import MAX_INFLUENCES
+from blender_fixtures import (
+    LOWER_BONE,
+    UPPER_BONE,
+    build_rig_scene,
+    expected_body_weights,
+    local_positions,
+    mesh_object,
+    reset_scene,
+)
+
+BONES = [LOWER_BONE, UPPER_BONE]
+#: What the transfer reports for the reference scene's sleeve: its 544 tube
+#: vertices copied, the 8 of the button (a part with no match) inpainted.
+SLEEVE_SUMMARY = "544 copied, 8 inpainted (1%), 8 on parts with no match"
+TRANSFER_ARGUMENTS = ["--source", "Body", "--out", "o.blend"]
+SKIN_ARGUMENTS = ["--out", "o.blend"]
 
 
 def save_rig_blend(path, sleeve_offset=(0.0, 0.0, 0.0)):
@@ -28,20 +54,49 @@ def open_blend(path):
     return bpy.data.objects
 
 
-def test_help_lists_subcommands_without_loading_blender():
+def parse(arguments):
+    return build_parser().parse_args(arguments)
+
+
+def run_main(arguments, capsys):
+    """``main(arguments)``: (exit code, stdout, stderr)."""
+    capsys.readouterr()
+    code = main(arguments)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def assert_tube_weights_follow_the_body(sleeve, positions):
+    """The sleeve's tube copies the body's linear blend; the button goes wholly to Lower."""
+    weights = convert.read_weights(sleeve, BONES).matrix
+    tube = np.hypot(positions[:, 0], positions[:, 1]) < 0.4
+    assert tube.sum() > 500 and (~tube).sum() >= 8
+    np.testing.assert_allclose(weights[tube], expected_body_weights(positions[tube, 2]), atol=1e-3)
+    np.testing.assert_allclose(weights[~tube], [[1.0, 0.0]] * int((~tube).sum()), atol=1e-3)
+
+
+# --------------------------------------------------------------------------- parser, exit codes
+
+
+def test_help_lists_every_subcommand_without_loading_blender(repository_root):
     result = subprocess.run(
         [sys.executable, "-c", "import sys; from autorig_addon.cli import main; code = main(['--help']); "
          "sys.exit(3 if 'bpy' in sys.modules else code)"],
-        cwd=REPOSITORY_ROOT, capture_output=True, text=True, timeout=60,
+        cwd=repository_root, capture_output=True, text=True, timeout=60,
     )
     assert result.returncode == 0, result.stderr
-    assert "transfer" in result.stdout and "package" in result.stdout
+    text = " ".join(result.stdout.split())
+    assert list(SUBCOMMANDS) == ["transfer", "skin", "eval", "package"]
+    for name, subcommand in SUBCOMMANDS.items():
+        assert f"{name} {subcommand.help}" in text
 
 
-def test_python_dash_m_entry_point_exits_with_usage_code():
-    result = subprocess.run([sys.executable, "-m", "autorig_addon"], cwd=REPOSITORY_ROOT, capture_output=True, text=True, timeout=60)
+def test_python_dash_m_without_subcommand_prints_usage_and_exits_2(repository_root):
+    result = subprocess.run([sys.executable, "-m", "autorig_addon"], cwd=repository_root, capture_output=True,
+                            text=True, timeout=60)
     assert result.returncode == 2
-    assert "transfer" in result.stderr
+    assert result.stderr.startswith("usage: python -m autorig_addon [-h] SUBCOMMAND ...")
+    assert result.stdout == ""
 
 
 @pytest.mark.parametrize(
@@ -53,49 +108,160 @@ def test_python_dash_m_entry_point_exits_with_usage_code():
     ],
 )
 def test_arguments_from_sys_argv(argv, expected):
-    assert cli.arguments_from_sys_argv(argv) == expected
+    assert arguments_from_sys_argv(argv) == expected
 
 
-def test_usage_errors_return_2(clean_scene, tmp_path):
-    assert cli.main([]) == 2
-    assert cli.main(["transfer", "in.blend"]) == 2  # no --source / --out
-    assert cli.main(["transfer", str(tmp_path), "--source", "Body", "--out", str(tmp_path / "out")]) == 2  # empty folder
-    assert cli.main(["transfer", "in.blend", "--source", "B", "--out", "o.blend", "--mix", "1.5"]) == 2
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["transfer", "in.blend"], "error: the following arguments are required: --out, --source"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--mix", "1.5"], "error: argument --mix: 1.5 is not between 0 and 1"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--smoothing-iterations", str(MAX_SMOOTHING_ITERATIONS + 1)],
+         f"error: argument --smoothing-iterations: {MAX_SMOOTHING_ITERATIONS + 1} is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-influences", "-1"],
+         f"error: argument --max-influences: -1 is not between 0 and {MAX_INFLUENCES}"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-normal-angle", "181"],
+         "error: argument --max-normal-angle: 181 is not between 0.1 and 180"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-distance", "0"], "error: argument --max-distance: 0 is not positive"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--replace", "some"], "error: argument --replace: invalid choice: 'some'"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", str(MAX_RESOLUTION + 1)],
+         f"error: argument --resolution: {MAX_RESOLUTION + 1} is not between {MIN_RESOLUTION} and {MAX_RESOLUTION}"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", "fine"], "error: argument --resolution: fine is not an integer"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--falloff", "0.05"], "error: argument --falloff: 0.05 is not between 0.1 and 64"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--distance", "euclidean"], "error: argument --distance: invalid choice: 'euclidean'"),
+    ],
+)
+def test_bad_arguments_exit_2_with_the_reason(arguments, message, capsys):
+    code, out, err = run_main(arguments, capsys)
+    assert code == 2 and out == ""
+    assert message in err
+
+
+def test_no_subcommand_and_empty_input_folder_exit_2(tmp_path, capsys):
+    code, _, err = run_main([], capsys)
+    assert code == 2 and err.startswith("usage: python -m autorig_addon")
+    code, out, err = run_main(["transfer", str(tmp_path), "--source", "Body", "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and out == ""
+    assert err == f"error: No input files found in {tmp_path} (looked for .blend, .glb, .gltf, .fbx, .obj).\n"
+
+
+def test_option_bounds_are_the_panels(clean_scene):
+    """Each number the CLI checks has the same bounds as its panel property
+    (both come from the core); the angle is in degrees here, radians there."""
+    properties = clean_scene.autorig.bl_rna.properties
+    bounds = [
+        ("transfer", "--distance-fraction", "distance_fraction",
+         transfer_options.MIN_DISTANCE_FRACTION, transfer_options.MAX_DISTANCE_FRACTION),
+        ("transfer", "--smoothing-iterations", "smoothing_iterations", 0, MAX_SMOOTHING_ITERATIONS),
+        ("transfer", "--max-influences", "max_influences", 0, MAX_INFLUENCES),
+        ("transfer", "--smoothing-strength", "smoothing_strength", 0.0, 1.0),
+        ("skin", "--resolution", "skin_resolution", MIN_RESOLUTION, MAX_RESOLUTION),
+        ("skin", "--falloff", "skin_falloff", skinning.MIN_FALLOFF, skinning.MAX_FALLOFF),
+        ("skin", "--max-influences", "skin_max_influences", 0, MAX_INFLUENCES),
+        ("skin", "--smoothing-iterations", "skin_smoothing_iterations", 0, MAX_SMOOTHING_ITERATIONS),
+    ]
+    for subcommand, option, name, low, high in bounds:
+        assert (properties[name].hard_min, properties[name].hard_max) == (pytest.approx(low), pytest.approx(high)), name
+        common = TRANSFER_ARGUMENTS if subcommand == "transfer" else SKIN_ARGUMENTS
+        destination = option[2:].replace("-", "_")
+        for value in (low, high):
+            assert getattr(parse([subcommand, "in.blend", *common, option, str(value)]), destination) == value
+    angle = properties["max_normal_angle"]
+    assert math.degrees(angle.hard_min) == pytest.approx(transfer_options.MIN_MAX_NORMAL_ANGLE)
+    assert math.degrees(angle.hard_max) == pytest.approx(transfer_options.MAX_MAX_NORMAL_ANGLE)
+
+
+def test_defaults_are_the_panels_and_the_cores(clean_scene):
+    settings = clean_scene.autorig
+    transfer = parse(["transfer", "in.blend", *TRANSFER_ARGUMENTS])
+    assert cli_transfer.transfer_settings(transfer) == TransferSettings(
+        options=TransferOptions(), mask_group=transfer_options.DEFAULT_MASK_GROUP,
+    )
+    assert transfer.distance_fraction == pytest.approx(settings.distance_fraction)
+    assert transfer.max_normal_angle == pytest.approx(math.degrees(settings.max_normal_angle))
+    assert (transfer.accept_flipped_normals, transfer.smoothing_iterations, transfer.max_influences, transfer.mask_group) == (
+        settings.accept_flipped_normals, settings.smoothing_iterations, settings.max_influences, settings.mask_group)
+    assert transfer.smoothing_strength == pytest.approx(settings.smoothing_strength)
+    skin = parse(["skin", "in.blend", *SKIN_ARGUMENTS])
+    assert (skin.distance.upper(), skin.resolution, skin.max_influences, skin.smoothing_iterations) == (
+        settings.skin_distance, settings.skin_resolution, settings.skin_max_influences, settings.skin_smoothing_iterations)
+    assert (skin.resolution, skin.distance) == (DEFAULT_RESOLUTION, skinning.DEFAULT_METHOD)
+    assert skin.falloff == pytest.approx(settings.skin_falloff) and skin.falloff == skinning.DEFAULT_FALLOFF
+    assert skin.smoothing_strength == pytest.approx(settings.skin_smoothing_strength)
+
+
+@pytest.mark.parametrize(
+    ("extra", "mode", "factor", "bones"),
+    [([], "REPLACE", 1.0, None), (["--mix", "0.25"], MIX, 0.25, None), (["--replace", "all", "--bones", "Lower, Upper"],
+                                                                          REPLACE_ALL, 1.0, ("Lower", "Upper"))],
+)
+def test_write_options_become_transfer_settings(extra, mode, factor, bones):
+    settings = cli_transfer.transfer_settings(parse(["transfer", "in.blend", *TRANSFER_ARGUMENTS, *extra]))
+    assert (settings.replace_mode, settings.mix_factor, settings.bones) == (mode, factor, bones)
+
+
+# --------------------------------------------------------------------------- batch machinery
+
+
+def test_output_paths_keep_sub_folders_and_number_clashes(tmp_path):
+    items = [(tmp_path / "a.blend", tmp_path.joinpath("a.blend").relative_to(tmp_path)),
+             (tmp_path / "a.glb", tmp_path.joinpath("a.glb").relative_to(tmp_path)),
+             (tmp_path / "sub" / "b.fbx", tmp_path.joinpath("sub", "b.fbx").relative_to(tmp_path))]
+    out = tmp_path / "out"
+    assert output_paths(items, str(out), True, "glb") == [out / "a.glb", out / "a_2.glb", out / "sub" / "b.glb"]
+    assert output_paths(items[:1], str(tmp_path / "x.fbx"), False, "glb") == [tmp_path / "x.fbx"]
+    assert output_paths(items[:1], str(out), False, "blend") == [out / "a.blend"]  # no extension: a folder
+
+
+def test_text_progress_draws_the_overall_fraction():
+    stream = io.StringIO()
+    bar = TextProgress(2, stream)
+    bar.update(1, "b.blend", 0.6, "Matching")  # second of two files, 60 % done: 80 % overall
+    bar.update(1, "b.blend", 0.601, "Matching")  # under the redraw step: nothing drawn
+    bar.finish_item(1, "b.blend", "ok -> out/b.blend")
+    assert stream.getvalue() == (
+        "\r[" + "#" * 24 + "-" * 6 + "]  80% 2/2 b.blend: Matching\x1b[K"
+        "\r2/2 b.blend: ok -> out/b.blend\x1b[K\n"
+    )
+
+
+# --------------------------------------------------------------------------- transfer runs
 
 
 def test_transfer_one_blend_file(clean_scene, tmp_path, capsys):
     source_path, out_path, summary_path = tmp_path / "scene.blend", tmp_path / "out" / "weighted.blend", tmp_path / "summary.json"
     sleeve_positions = save_rig_blend(source_path)
-    capsys.readouterr()
 
-    code = cli.main([
+    code, out, _ = run_main([
         "transfer", str(source_path), "--source", "Body", "--target", "Sleeve", "--out", str(out_path),
-        "--summary", str(summary_path), "--max-influences", "1", "--quiet",
-    ])
+        "--summary", str(summary_path), "--quiet",
+    ], capsys)
 
     assert code == 0
     summary = json.loads(summary_path.read_text())
-    assert json.loads(capsys.readouterr().out) == summary
-    assert [item["input"] for item in summary["succeeded"]] == [str(source_path)] and summary["failed"] == []
-    assert "Sleeve" in summary["succeeded"][0]["targets"]
+    assert json.loads(out) == summary
+    (item,) = summary["succeeded"]
+    assert summary["failed"] == [] and item.pop("seconds") > 0
+    assert item == {"input": str(source_path), "output": str(out_path), "targets": {"Sleeve": SLEEVE_SUMMARY}}
     objects = open_blend(out_path)
     sleeve = objects["Sleeve"]
     assert sorted(objects.keys()) == ["Armature", "Body", "Sleeve"]
     np.testing.assert_array_equal(local_positions(sleeve), sleeve_positions)  # vertex order kept
-    weights = convert.read_weights(sleeve, [LOWER_BONE, UPPER_BONE]).matrix
-    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)
-    assert np.count_nonzero(weights, axis=1).max() == 1
-    low = np.flatnonzero(sleeve_positions[:, 2] < 0.7)
-    assert weights[low, 0].min() > 0.999
+    assert_tube_weights_follow_the_body(sleeve, sleeve_positions)
     assert sleeve.parent == objects["Armature"]
 
 
-def test_default_targets_are_unrigged_meshes(clean_scene, tmp_path, capsys):
+def test_max_influences_and_default_targets(clean_scene, tmp_path, capsys):
     source_path = tmp_path / "scene.blend"
     save_rig_blend(source_path)
-    capsys.readouterr()
-    assert cli.main(["transfer", str(source_path), "--source", "Body", "--out", str(tmp_path / "o.blend"), "--quiet"]) == 0
-    assert list(json.loads(capsys.readouterr().out)["succeeded"][0]["targets"]) == ["Sleeve"]
+    code, out, _ = run_main(["transfer", str(source_path), "--source", "Body", "--out", str(tmp_path / "o.blend"),
+                             "--max-influences", "1", "--quiet"], capsys)
+    assert code == 0
+    # The only mesh not bound to an armature is the sleeve.
+    assert json.loads(out)["succeeded"][0]["targets"] == {"Sleeve": SLEEVE_SUMMARY}
+    weights = convert.read_weights(open_blend(tmp_path / "o.blend")["Sleeve"], BONES).matrix
+    np.testing.assert_array_equal(np.count_nonzero(weights, axis=1), 1)
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)
 
 
 def test_batch_with_bad_files_keeps_going_and_exits_1(clean_scene, tmp_path, capsys):
@@ -107,68 +273,63 @@ def test_batch_with_bad_files_keeps_going_and_exits_1(clean_scene, tmp_path, cap
     mesh_object("Lonely", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
     bpy.ops.wm.save_as_mainfile(filepath=str(inputs / "no_body.blend"), copy=True)
     (inputs / "broken.glb").write_bytes(b"not a gltf file")
-    capsys.readouterr()
     out_dir, summary_path = tmp_path / "out", tmp_path / "summary.json"
 
-    code = cli.main(["transfer", str(inputs), "--source", "Body", "--target", "Sleeve", "--out", str(out_dir), "--summary", str(summary_path)])
+    code, out, err = run_main(["transfer", str(inputs), "--source", "Body", "--target", "Sleeve", "--out", str(out_dir),
+                               "--summary", str(summary_path)], capsys)
 
     assert code == 1
-    captured = capsys.readouterr()
-    summary = json.loads(captured.out)
+    summary = json.loads(out)
     assert summary == json.loads(summary_path.read_text())
     assert [item["input"] for item in summary["succeeded"]] == [str(inputs / "good.blend")]
     failed = {item["input"]: item["error"] for item in summary["failed"]}
-    assert set(failed) == {str(inputs / name) for name in ("broken.glb", "more/far.blend", "no_body.blend")}
-    assert "does not overlap" in failed[str(inputs / "more" / "far.blend")]
-    assert "No mesh object named 'Body'" in failed[str(inputs / "no_body.blend")]
-    assert (out_dir / "good.blend").is_file()
-    assert not (out_dir / "no_body.blend").exists()
-    assert "4/4" in captured.err  # the progress bar went through every file
-    objects = open_blend(out_dir / "good.blend")
-    assert convert.read_weights(objects["Sleeve"], [LOWER_BONE]).matrix.max() == pytest.approx(1.0)
+    assert list(failed) == [str(inputs / name) for name in ("broken.glb", "more/far.blend", "no_body.blend")]
+    assert failed[str(inputs / "more" / "far.blend")] == (
+        "'Sleeve' does not overlap the source 'Body': move the garment onto the body "
+        "(or apply the object transforms) before transferring."
+    )
+    assert failed[str(inputs / "no_body.blend")] == "No mesh object named 'Body'. Available: Lonely."
+    assert "Bad glTF" in failed[str(inputs / "broken.glb")]  # Blender's importer's own words
+    assert sorted(path.relative_to(out_dir).as_posix() for path in out_dir.rglob("*.blend")) == ["good.blend"]
+    # The progress ends each file with its own line, numbered out of four in path order.
+    assert "\r1/4 broken.glb: FAILED: " in err
+    assert f"\r2/4 good.blend: ok -> {out_dir / 'good.blend'}\x1b[K\n" in err
+    assert f"\r3/4 far.blend: FAILED: {failed[str(inputs / 'more' / 'far.blend')]}\x1b[K\n" in err
+    assert f"\r4/4 no_body.blend: FAILED: {failed[str(inputs / 'no_body.blend')]}\x1b[K\n" in err
+    sleeve = open_blend(out_dir / "good.blend")["Sleeve"]
+    assert_tube_weights_follow_the_body(sleeve, local_positions(sleeve))
 
 
 def test_missing_input_file_fails_alone(clean_scene, tmp_path, capsys):
     save_rig_blend(tmp_path / "good.blend")
-    capsys.readouterr()
-    code = cli.main([
+    code, out, _ = run_main([
         "transfer", str(tmp_path / "missing.blend"), str(tmp_path / "good.blend"),
         "--source", "Body", "--out", str(tmp_path / "out"), "--quiet",
-    ])
+    ], capsys)
     assert code == 1
-    summary = json.loads(capsys.readouterr().out)
-    assert summary["failed"][0]["input"] == str(tmp_path / "missing.blend")
-    assert "does not exist" in summary["failed"][0]["error"]
+    summary = json.loads(out)
+    assert summary["failed"] == [{"input": str(tmp_path / "missing.blend"),
+                                  "error": f"The file '{tmp_path / 'missing.blend'}' does not exist."}]
+    assert [item["output"] for item in summary["succeeded"]] == [str(tmp_path / "out" / "good.blend")]
     assert (tmp_path / "out" / "good.blend").is_file()
 
 
 def test_glb_output_round_trip(clean_scene, tmp_path, capsys):
     save_rig_blend(tmp_path / "scene.blend")
     out_path = tmp_path / "weighted.glb"
-    assert cli.main(["transfer", str(tmp_path / "scene.blend"), "--source", "Body", "--target", "Sleeve",
-                     "--out", str(out_path), "--quiet"]) == 0
+    code, _, _ = run_main(["transfer", str(tmp_path / "scene.blend"), "--source", "Body", "--target", "Sleeve",
+                           "--out", str(out_path), "--quiet"], capsys)
+    assert code == 0
     from autorig_addon.blender import scene_io
 
     scene_io.load_scene(out_path)
-    skinned = [obj for obj in bpy.data.objects if obj.type == "MESH" and {LOWER_BONE, UPPER_BONE} <= set(obj.vertex_groups.keys())]
-    assert len(skinned) == 2  # body and sleeve both come back with their bone groups
+    sleeve = bpy.data.objects["Sleeve"]
+    assert sorted(group.name for group in sleeve.vertex_groups) == BONES
+    # glTF splits vertices at seams, so compare by position, not by index.
+    assert_tube_weights_follow_the_body(sleeve, np.array([vertex.co[:] for vertex in sleeve.data.vertices]))
 
 
-def test_package_subcommand_calls_build_packages(monkeypatch, tmp_path, capsys):
-    calls = []
-
-    def build_packages(out_dir, platforms):
-        calls.append((out_dir, platforms))
-        return [f"{out_dir}/autorig-{platform}.zip" for platform in platforms]
-
-    monkeypatch.setitem(sys.modules, "autorig_addon.packaging", types.SimpleNamespace(build_packages=build_packages))
-    code = cli.main(["package", "--out", str(tmp_path), "--platform", "linux-x64", "--platform", "windows-x64"])
-    assert code == 0
-    assert calls == [(str(tmp_path), ["linux-x64", "windows-x64"])]
-    assert capsys.readouterr().out.split() == [f"{tmp_path}/autorig-linux-x64.zip", f"{tmp_path}/autorig-windows-x64.zip"]
-
-
-def test_subprocess_stdout_is_pure_json(tmp_path):
+def test_subprocess_stdout_is_pure_json(tmp_path, repository_root):
     """Blender prints from C while loading and saving; none of it may reach stdout."""
     script = (
         "import sys, bpy; sys.path[:0] = [sys.argv[1], sys.argv[1] + '/tests']; "
@@ -176,27 +337,69 @@ def test_subprocess_stdout_is_pure_json(tmp_path):
         "bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2], copy=True)"
     )
     source_path = tmp_path / "scene.blend"
-    subprocess.run([sys.executable, "-c", script, str(REPOSITORY_ROOT), str(source_path)], check=True, capture_output=True, timeout=120)
+    subprocess.run([sys.executable, "-c", script, str(repository_root), str(source_path)], check=True,
+                   capture_output=True, timeout=120)
     result = subprocess.run(
         [sys.executable, "-m", "autorig_addon", "transfer", str(source_path), "--source", "Body", "--target", "Sleeve",
          "--out", str(tmp_path / "out.blend")],
-        cwd=REPOSITORY_ROOT, capture_output=True, text=True, timeout=120,
+        cwd=repository_root, capture_output=True, text=True, timeout=120,
     )
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
-    assert summary["succeeded"][0]["output"] == str(tmp_path / "out.blend")
-    assert "1/1 scene.blend: ok" in result.stderr
+    assert summary["failed"] == [] and summary["succeeded"][0]["output"] == str(tmp_path / "out.blend")
+    assert summary["succeeded"][0]["targets"] == {"Sleeve": SLEEVE_SUMMARY}
+    assert f"1/1 scene.blend: ok -> {tmp_path / 'out.blend'}" in result.stderr
+
+
+# --------------------------------------------------------------------------- package
+
+
+def test_package_prints_each_zip(monkeypatch, tmp_path, capsys):
+    calls = []
+
+    def build_packages(out_dir, platforms, wheel_cache):
+        calls.append((out_dir, platforms, wheel_cache))
+        return [f"{out_dir}/autorig-{platform}.zip" for platform in platforms]
+
+    monkeypatch.setattr(packaging, "build_packages", build_packages)
+    code, out, _ = run_main(["package", "--out", str(tmp_path), "--platform", "linux-x64", "--platform", "windows-x64",
+                             "--wheel-cache", "cache"], capsys)
+    assert code == 0
+    assert calls == [(str(tmp_path), ["linux-x64", "windows-x64"], "cache")]
+    assert out == f"{tmp_path}/autorig-linux-x64.zip\n{tmp_path}/autorig-windows-x64.zip\n"
+
+
+def test_package_download_failure_exits_1(monkeypatch, tmp_path, capsys):
+    """A failed build is not a usage error: the command line was right."""
+    message = "pip could not download scipy==0.0.1 for platform tags win_amd64. Check the network."
+
+    def build_packages(out_dir, platforms, wheel_cache):
+        raise packaging.PackagingError(message)
+
+    monkeypatch.setattr(packaging, "build_packages", build_packages)
+    code, out, err = run_main(["package", "--out", str(tmp_path)], capsys)
+    assert (code, out, err) == (1, "", f"error: {message}\n")
+
+
+def test_package_unknown_platform_exits_2_before_building(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(packaging, "build_packages", lambda *arguments: pytest.fail("must not build"))
+    code, out, err = run_main(["package", "--out", str(tmp_path), "--platform", "macos-x64"], capsys)
+    assert (code, out) == (2, "")
+    assert err == "error: Unknown platform(s) macos-x64; choose from linux-x64, windows-x64, macos-arm64.\n"
+
+
+# --------------------------------------------------------------------------- scene files
 
 
 def test_scene_io_rejects_unknown_and_missing_files(clean_scene, tmp_path):
     from autorig_addon.blender import scene_io
     from autorig_addon.core.errors import InputError
 
-    with pytest.raises(InputError, match=r"Cannot read 'scene.usd': use one of \.blend"):
+    with pytest.raises(InputError, match=r"^Cannot read 'scene.usd': use one of \.blend, \.glb, \.gltf, \.fbx, \.obj\.$"):
         scene_io.load_scene(tmp_path / "scene.usd")
-    with pytest.raises(InputError, match="does not exist"):
+    with pytest.raises(InputError, match=r"^The file '.*missing\.fbx' does not exist\.$"):
         scene_io.load_scene(tmp_path / "missing.fbx")
-    with pytest.raises(InputError, match="Cannot write 'scene.obj'"):
+    with pytest.raises(InputError, match=r"^Cannot write 'scene.obj': use one of \.blend, \.glb, \.gltf, \.fbx\.$"):
         scene_io.save_scene(tmp_path / "scene.obj")
 
 

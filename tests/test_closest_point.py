@@ -1,6 +1,9 @@
+"""Closest points on triangles and triangle meshes (core/geometry/closest_point)."""
+
 import numpy as np
 
 from autorig_addon.core.geometry.closest_point import TriangleMeshQuery, closest_points_on_triangles
+from autorig_addon.core.geometry.segments import point_segment_distances
 from geometry_fixtures import cylinder, grid
 
 
@@ -30,18 +33,24 @@ def test_surface_point_beats_nearest_vertex_on_coarse_mesh():
     np.testing.assert_allclose(result.points, [[5, 5, 0], [2, 7, 0]], atol=1e-12)
 
 
-def test_distances_to_a_cylinder_match_the_radius_gap():
-    mesh = cylinder(radius=0.1, segments=64, capped=False)
+def test_distances_to_a_faceted_cylinder_are_those_to_its_polygon():
+    # The side of the cylinder is a prism over a 64-gon: from a point beside
+    # it (within its height) the closest point is level with it, at the
+    # distance to the polygon in the point's horizontal plane.
+    segments = 64
+    mesh = cylinder(radius=0.1, segments=segments, capped=False)
     query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
     rng = np.random.default_rng(1)
     angle, z = rng.uniform(0, 2 * np.pi, 200), rng.uniform(0.1, 0.9, 200)
     P = np.column_stack([0.13 * np.cos(angle), 0.13 * np.sin(angle), z])
     result = query.closest(P)
-    # Flat facets sit inside the circle by at most r (1 - cos(pi / 64)).
-    assert np.all(result.distances >= 0.03 - 1e-12)
-    assert np.all(result.distances <= 0.03 + 0.1 * (1 - np.cos(np.pi / 64)) + 1e-12)
-    values = mesh.vertices[:, 2]
-    np.testing.assert_allclose(result.interpolate(mesh.triangles, values), z, atol=1e-9)
+    corners = mesh.vertices[:segments] * [1, 1, 0]
+    polygon = point_segment_distances(P * [1, 1, 0], corners, np.roll(corners, -1, axis=0)).min(axis=1)
+    np.testing.assert_allclose(result.distances, polygon, atol=1e-12)
+    np.testing.assert_allclose(result.points[:, 2], z, atol=1e-12)
+    np.testing.assert_allclose(result.interpolate(mesh.triangles, mesh.vertices[:, 2]), z, atol=1e-12)
+    # The facets lie inside the circle by at most r (1 - cos(pi / 64)).
+    assert 0.03 - 1e-12 <= polygon.min() and polygon.max() <= 0.03 + 0.1 * (1 - np.cos(np.pi / segments)) + 1e-12
 
 
 def test_brute_force_agreement_on_random_points():
@@ -64,3 +73,18 @@ def test_closest_points_on_a_triangle_cover_every_region():
     count = len(points)
     _, bary = closest_points_on_triangles(points, np.tile(a, (count, 1)), np.tile(b, (count, 1)), np.tile(c, (count, 1)))
     np.testing.assert_allclose(bary, expected, atol=1e-12)
+
+
+def test_batches_and_empty_queries(monkeypatch):
+    from autorig_addon.core.geometry import closest_point
+
+    mesh = cylinder(radius=0.2, segments=12, rings=6)
+    query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
+    P = np.random.default_rng(4).uniform(-0.5, 1.5, size=(50, 3))
+    whole = query.closest(P)
+    monkeypatch.setattr(closest_point, "BATCH_SIZE", 7)
+    batched = query.closest(P)
+    for name in ("points", "distances", "triangles", "barycentric"):
+        np.testing.assert_array_equal(getattr(batched, name), getattr(whole, name))
+    empty = query.closest(np.zeros((0, 3)))
+    assert empty.points.shape == (0, 3) and empty.distances.shape == (0,) and empty.triangles.dtype == np.int64

@@ -1,15 +1,14 @@
-"""Blender <-> array conversion (autorig_addon.blender.convert), real bpy."""
+"""Reading Blender objects into arrays (autorig_addon.blender.convert), real bpy."""
 
-import math
+import re
 
 import bpy
 import numpy as np
 import pytest
-from mathutils import Euler, Vector
+from mathutils import Euler, Quaternion, Vector
 
 from autorig_addon.blender import convert
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.types import Weights
 from blender_fixtures import (
     LOWER_BONE,
     UPPER_BONE,
@@ -17,7 +16,6 @@ from blender_fixtures import (
     bind,
     box_geometry,
     build_rig_scene,
-    group_weights,
     local_positions,
     make_armature,
     mesh_object,
@@ -76,7 +74,10 @@ def test_read_mesh_concatenates_objects_with_offsets(clean_scene):
     assert mesh.object_names == ("First", "Second")
     np.testing.assert_array_equal(mesh.object_offsets, [0, 8, 16])
     np.testing.assert_allclose(mesh.vertices[mesh.object_slice(1)], vertices, atol=1e-6)
-    assert mesh.triangles[12:].min() == 8 and mesh.triangles[:12].max() == 7
+    # The second object's triangles are its own, shifted by the first's 8 vertices.
+    np.testing.assert_array_equal(mesh.triangles[:12], convert.read_mesh(first).triangles)
+    np.testing.assert_array_equal(mesh.triangles[12:], convert.read_mesh(second).triangles + 8)
+    np.testing.assert_array_equal(mesh.triangle_polygons, np.tile(np.repeat(np.arange(6), 2), 2))
 
 
 def test_read_mesh_uses_deformed_geometry_when_vertex_count_is_kept(clean_scene):
@@ -99,13 +100,18 @@ def test_read_mesh_uses_deformed_geometry_when_vertex_count_is_kept(clean_scene)
     np.testing.assert_allclose(mesh.vertices, vertices, atol=1e-6)
 
 
-def test_read_mesh_rejects_non_meshes_and_faceless_meshes(clean_scene):
+def test_read_mesh_rejects_non_meshes_faceless_meshes_and_nothing(clean_scene):
     armature = make_armature()
-    with pytest.raises(InputError, match="'Armature' is not a mesh \\(its type is Armature\\)"):
+    with pytest.raises(InputError, match=re.escape(
+            "The mesh 'Armature' is not a mesh (its type is Armature): pick a mesh object.")):
         convert.read_mesh(armature)
     wire = mesh_object("Wire", [(0, 0, 0), (1, 0, 0), (1, 1, 0)], [], edges=[(0, 1), (1, 2)])
-    with pytest.raises(InputError, match="'Wire' has no faces"):
+    with pytest.raises(InputError, match=re.escape(
+            "'Wire' has no faces: it is only vertices or edges. Add faces to it (Edit Mode > Face > Fill) "
+            "or pick a mesh with a surface.")):
         convert.read_mesh(wire)
+    with pytest.raises(InputError, match="^No mesh objects given.$"):
+        convert.read_mesh([])
 
 
 def test_read_skeleton_world_space_parents_first(clean_scene):
@@ -127,7 +133,8 @@ def test_read_skeleton_orders_parents_before_children(clean_scene):
     bpy.context.scene.collection.objects.link(armature)
     bpy.context.view_layer.objects.active = armature
     bpy.ops.object.mode_set(mode="EDIT")
-    # Created children first, so storage order need not be parents first.
+    # Created children first; the skeleton still comes parents first (the
+    # reordering itself is tested on arrays in test_skeleton_hierarchy.py).
     tip = data.edit_bones.new("Tip")
     tip.head, tip.tail = (0, 0, 2), (0, 0, 3)
     middle = data.edit_bones.new("Middle")
@@ -142,12 +149,32 @@ def test_read_skeleton_orders_parents_before_children(clean_scene):
     np.testing.assert_allclose(skeleton.joints[:, 2], [0.0, 1.0, 2.0], atol=1e-6)
 
 
+def test_read_skeleton_refuses_non_armatures_and_empty_armatures(clean_scene):
+    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
+    box = mesh_object("Box", vertices, faces)
+    with pytest.raises(InputError, match="^'Box' is not an armature object.$"):
+        convert.read_skeleton(box)
+    with pytest.raises(InputError, match="^None is not an armature object.$"):
+        convert.read_skeleton(None)
+    empty = bpy.data.objects.new("Empty Rig", bpy.data.armatures.new("Empty Rig"))
+    bpy.context.scene.collection.objects.link(empty)
+    with pytest.raises(InputError, match="^The armature 'Empty Rig' has no bones.$"):
+        convert.read_skeleton(empty)
+
+
+def test_deform_bone_names_lists_only_deforming_bones(clean_scene):
+    assert convert.deform_bone_names(make_armature()) == (LOWER_BONE, UPPER_BONE)
+    assert convert.deform_bone_names(make_armature("Half", deform_upper=False)) == (LOWER_BONE,)
+
+
 def test_find_armature_from_modifier_or_parent(clean_scene):
     rig = build_rig_scene()
     assert convert.find_armature(rig.body) == rig.armature
     rig.body.modifiers.clear()
     assert convert.find_armature(rig.body) == rig.armature  # still the parent
-    with pytest.raises(InputError, match="'Sleeve' is not bound to an armature"):
+    with pytest.raises(InputError, match=re.escape(
+            "'Sleeve' is not bound to an armature: give it an Armature modifier "
+            "or parent it to the armature (Ctrl+P > With Empty Groups) first.")):
         convert.find_armature(rig.sleeve)
 
 
@@ -162,129 +189,21 @@ def test_read_weights_matches_groups_and_fills_missing_with_zero(clean_scene):
     np.testing.assert_allclose(weights.matrix[:, 2], 1.0 - expected_upper, atol=1e-6)
 
 
-def random_weights(vertex_count, names, seed=0):
-    rng = np.random.default_rng(seed)
-    matrix = rng.random((vertex_count, len(names)))
-    matrix[rng.random(matrix.shape) < 0.3] = 0.0
-    return Weights(matrix, names)
+def test_read_weights_refuses_a_non_mesh(clean_scene):
+    with pytest.raises(InputError, match=re.escape("The object 'Armature' is not a mesh (its type is Armature)")):
+        convert.read_weights(make_armature(), [LOWER_BONE])
 
 
-def test_write_weights_round_trip_preserves_other_groups_and_skips_zeros(clean_scene):
-    rig = build_rig_scene()
-    sleeve = rig.sleeve
-    keep = sleeve.vertex_groups.new(name="Keep")
-    keep.add([0, 1, 2], 0.75, "REPLACE")
-    stale = sleeve.vertex_groups.new(name=LOWER_BONE)
-    stale.add(list(range(len(sleeve.data.vertices))), 0.1, "REPLACE")
-    weights = random_weights(len(sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
-
-    convert.write_weights(sleeve, weights, rig.armature)
-
-    read_back = convert.read_weights(sleeve, weights.bone_names).matrix
-    np.testing.assert_allclose(read_back, weights.matrix, atol=1e-6)
-    lower_index = sleeve.vertex_groups[LOWER_BONE].index
-    members = sum(any(g.group == lower_index for g in v.groups) for v in sleeve.data.vertices)
-    assert members == np.count_nonzero(weights.matrix[:, 0])  # zeros (and the stale 0.1) are gone
-    np.testing.assert_allclose(group_weights(sleeve, ["Keep"])[:3, 0], 0.75)
-    assert group_weights(sleeve, ["Keep"])[3:].sum() == 0.0
-
-
-def test_write_weights_never_writes_non_deform_or_unknown_bones(clean_scene):
-    armature = make_armature(deform_upper=False)
-    vertices, faces = box_geometry((0.0, 0.0, 0.5), 0.3)
-    box = mesh_object("Box", vertices, faces)
-    weights = Weights(np.full((8, 3), 1.0 / 3.0), (LOWER_BONE, UPPER_BONE, "NotABone"))
-    convert.write_weights(box, weights, armature)
-    assert [group.name for group in box.vertex_groups] == [LOWER_BONE]
-
-
-def test_write_weights_replace_all_keeps_only_listed_groups(clean_scene):
-    rig = build_rig_scene()
-    for name in ("Pin", "AutoRig Inpaint"):
-        rig.sleeve.vertex_groups.new(name=name).add([0], 1.0, "REPLACE")
-    weights = random_weights(len(rig.sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
-    convert.write_weights(rig.sleeve, weights, rig.armature, replace_all=True, keep_groups=["AutoRig Inpaint"])
-    assert sorted(group.name for group in rig.sleeve.vertex_groups) == ["AutoRig Inpaint", LOWER_BONE, UPPER_BONE]
-
-
-def test_write_weights_binds_once_and_keeps_world_transform(clean_scene):
-    rig = build_rig_scene()
-    rig.armature.location = (0.0, 1.0, 0.0)
-    rig.armature.rotation_euler = Euler((0.0, 0.0, math.radians(30)))
-    sleeve = rig.sleeve
-    sleeve.location = (0.2, 0.1, -0.3)
-    sleeve.scale = (1.5, 1.5, 1.5)
-    sleeve.modifiers.new("Smooth", "SUBSURF")
-    bpy.context.view_layer.update()
-    world_before = np.array(sleeve.matrix_world)
-    weights = random_weights(len(sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
-
-    convert.write_weights(sleeve, weights, rig.armature)
-    convert.write_weights(sleeve, weights, rig.armature)
-    bpy.context.view_layer.update()
-
-    armature_modifiers = [m for m in sleeve.modifiers if m.type == "ARMATURE"]
-    assert len(armature_modifiers) == 1 and armature_modifiers[0].object == rig.armature
-    assert sleeve.modifiers[0].type == "ARMATURE"  # deforms before the subdivision
-    assert sleeve.parent == rig.armature
-    np.testing.assert_allclose(np.array(sleeve.matrix_world), world_before, atol=1e-6)
-
-
-def test_write_weights_restores_everything_when_it_fails(clean_scene, monkeypatch):
-    rig = build_rig_scene()
-    sleeve = rig.sleeve
-    sleeve.vertex_groups.new(name=UPPER_BONE).add([0, 5], 0.4, "REPLACE")
-    sleeve.vertex_groups.new(name="Pin").add([1], 1.0, "REPLACE")
-    before = group_weights(sleeve, [UPPER_BONE, "Pin", LOWER_BONE])
-
-    def broken_binding(obj, armature_obj):
-        obj.modifiers.new("Half", "ARMATURE")
-        raise RuntimeError("disk full")
-
-    monkeypatch.setattr(convert, "ensure_armature_binding", broken_binding)
-    weights = random_weights(len(sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
-    with pytest.raises(RuntimeError, match="disk full"):
-        convert.write_weights(sleeve, weights, rig.armature)
-
-    assert [group.name for group in sleeve.vertex_groups] == [UPPER_BONE, "Pin"]
-    np.testing.assert_allclose(group_weights(sleeve, [UPPER_BONE, "Pin", LOWER_BONE]), before)
-    assert len(sleeve.modifiers) == 0 and sleeve.parent is None
-
-
-def test_write_weights_rejects_wrong_row_count(clean_scene):
-    rig = build_rig_scene()
-    with pytest.raises(InputError, match="has 552 vertices but the weights have 3 rows"):
-        convert.write_weights(rig.sleeve, Weights(np.ones((3, 1)), (LOWER_BONE,)), rig.armature)
-
-
-def test_status_attribute_values_and_colours(clean_scene):
+def test_vertex_group_mask_thresholds_the_group(clean_scene):
     vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
     box = mesh_object("Box", vertices, faces)
-    status = np.array([0, 1, 2, 3, 4, 5, 0, 2], dtype=np.int8)
-    convert.write_status_attribute(box, status)
-    convert.write_status_attribute(box, status)  # rewriting replaces, never duplicates
-    np.testing.assert_array_equal(convert.read_status_attribute(box), status)
-    colours = box.data.color_attributes[convert.STATUS_COLOR_ATTRIBUTE]
-    assert colours.data_type == "FLOAT_COLOR" and colours.domain == "POINT"
-    values = np.empty(8 * 4, dtype=np.float32)
-    colours.data.foreach_get("color", values)
-    values = values.reshape(8, 4)
-    assert values[0, 1] > 0.5 and values[0, 0] < 0.2  # copied: green
-    assert values[2, 0] > 0.5 and values[2, 1] < 0.2  # inpainted: red
-    assert values[4, 2] > 0.5 and values[4, 0] < 0.2  # protected: blue
-    assert box.data.color_attributes.active_color_name == convert.STATUS_COLOR_ATTRIBUTE
-    assert sum(a.name == convert.STATUS_ATTRIBUTE for a in box.data.attributes) == 1
-
-
-def test_snapshot_restores_status_attributes(clean_scene):
-    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
-    box = mesh_object("Box", vertices, faces)
-    first = np.arange(8) % 6
-    convert.write_status_attribute(box, first)
-    snapshot = convert.ObjectSnapshot.capture(box)
-    convert.write_status_attribute(box, np.zeros(8, dtype=int))
-    snapshot.restore()
-    np.testing.assert_array_equal(convert.read_status_attribute(box), first)
+    add_weights(box, ["Mask"], np.array([[0.2], [0.5], [1.0], [0], [0], [0], [0], [0.49]]))
+    add_weights(box, ["Faint"], np.full((8, 1), 0.1))
+    np.testing.assert_array_equal(convert.vertex_group_mask(box, "Mask", 0.5),
+                                  [False, True, True, False, False, False, False, False])
+    assert convert.vertex_group_mask(box, "Faint", 0.5) is None  # no member reaches the threshold
+    assert convert.vertex_group_mask(box, "Missing", 0.5) is None
+    assert convert.vertex_group_mask(box, "", 0.5) is None
 
 
 def test_read_weights_of_a_bound_mesh_after_write(clean_scene):
@@ -299,34 +218,13 @@ def test_read_weights_of_a_bound_mesh_after_write(clean_scene):
 
 
 def test_read_mesh_gives_the_rest_shape_of_a_posed_skinned_mesh(clean_scene):
-    import bpy
-    from mathutils import Quaternion
-
-    from autorig_addon.blender.convert import read_mesh
-    from blender_fixtures import build_rig_scene, local_positions
-
     scene = build_rig_scene(with_button=False)
     rest = local_positions(scene.body) @ np.array(scene.body.matrix_world)[:3, :3].T + np.array(scene.body.matrix_world)[:3, 3]
     bone = scene.armature.pose.bones["Upper"]
     bone.rotation_mode = "QUATERNION"
     bone.rotation_quaternion = Quaternion((1, 0, 0), 1.0)
     bpy.context.view_layer.update()
-    mesh = read_mesh([scene.body], bpy.context.evaluated_depsgraph_get())
+    mesh = convert.read_mesh([scene.body], bpy.context.evaluated_depsgraph_get())
     np.testing.assert_allclose(mesh.vertices, rest, atol=1e-5)
     assert scene.armature.data.pose_position == "POSE"  # restored
-    assert bone.rotation_quaternion.angle > 0.9
-
-
-def test_rebinding_to_another_armature_leaves_one_modifier_and_failure_restores_both(clean_scene):
-    from blender_fixtures import build_rig_scene, make_armature
-
-    scene = build_rig_scene(with_button=False)
-    other = make_armature("Other")
-    extra = scene.body.modifiers.new("Second", "ARMATURE")
-    extra.object = scene.armature
-    before = [(m.name, m.object.name) for m in scene.body.modifiers]
-    snapshot = convert.ObjectSnapshot.capture(scene.body)
-    convert.ensure_armature_binding(scene.body, other)
-    assert [(m.type, m.object.name) for m in scene.body.modifiers] == [("ARMATURE", "Other")]
-    snapshot.restore()
-    assert [(m.name, m.object.name) for m in scene.body.modifiers] == before
+    assert bone.rotation_quaternion.angle == pytest.approx(1.0)  # the pose itself is untouched

@@ -6,18 +6,25 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from autorig_addon.core.dataset import dataset
-from autorig_addon.core.dataset.dataset import (
+from autorig_addon.core import dataset
+from autorig_addon.core.dataset.cache import (
+    CACHE_ENVIRONMENT_VARIABLE,
+    DEFAULT_CACHE_ROOT,
+    build_samples,
+    default_cache_dir,
+    file_content_hash,
+)
+from autorig_addon.core.dataset.normalise import (
     FACING_AS_NAMED,
     FACING_TURNED,
     FACING_UNKNOWN,
-    CharacterSample,
     apply_transform,
     bone_side,
-    build_samples,
+    facing_quarter_turns,
     normalise,
-    read_data_split,
 )
+from autorig_addon.core.dataset.sample import SAMPLE_FORMAT_VERSION, CharacterSample
+from autorig_addon.core.dataset.split import category_of, read_data_split, relative_name, select_split
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 from geometry_fixtures import cylinder
@@ -84,27 +91,12 @@ def test_normalise_turns_a_character_facing_sideways_by_a_quarter():
     turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     turned_mesh = Mesh(mesh.vertices @ turn.T, mesh.triangles)
     turned = Skeleton(skeleton.joints @ turn.T, skeleton.parents, skeleton.names, skeleton.tails @ turn.T)
-    assert dataset.facing_quarter_turns(turned) == 3
+    assert facing_quarter_turns(turned) == 3
     result = normalise(turned_mesh, turned)
     assert result.facing == FACING_TURNED
     expected = normalise(mesh, skeleton)
     np.testing.assert_allclose(result.skeleton.joints, expected.skeleton.joints, atol=1e-12)
     np.testing.assert_allclose(result.mesh.vertices, expected.mesh.vertices, atol=1e-12)
-
-
-def test_subdivide_midpoints_keeps_the_shape_and_interpolates():
-    vertices = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]])
-    triangles = np.array([[0, 1, 2], [1, 3, 2]])
-    values = np.array([[0.0], [1.0], [2.0], [3.0]])  # = x / 2 + y, linear
-    new_vertices, new_triangles, new_values = dataset.subdivide_midpoints(vertices, triangles, values)
-    assert len(new_vertices) == 4 + 5 and len(new_triangles) == 8  # five edges, four children each
-    np.testing.assert_array_equal(new_vertices[:4], vertices)
-    np.testing.assert_allclose(new_values[:, 0], new_vertices[:, 0] / 2 + new_vertices[:, 1])
-    a, b, c = (new_vertices[new_triangles[:, k]] for k in range(3))
-    normals = np.cross(b - a, c - a)
-    # Each child is a quarter of its parent (area 2): area 0.5, so |cross| = 1, facing +z like the parent.
-    np.testing.assert_allclose(normals[:, 2], 1.0)
-    np.testing.assert_allclose(normals[:, :2], 0.0)
 
 
 def test_normalise_keeps_orientation_when_names_say_nothing():
@@ -113,6 +105,21 @@ def test_normalise_keeps_orientation_when_names_say_nothing():
     result = normalise(mesh, anonymous)
     assert result.facing == FACING_UNKNOWN
     assert result.transform[0, 0] > 0
+
+
+def test_normalise_rejects_meshes_without_extent():
+    skeleton = Skeleton([[0.0, 0.0, 0.0]], [-1], ("Root",))
+    with pytest.raises(InputError, match="The mesh has no vertices, so it cannot be normalised"):
+        normalise(Mesh(np.zeros((0, 3)), np.zeros((0, 3), int)), skeleton)
+    with pytest.raises(InputError, match="All vertices lie at one point, so the mesh cannot be normalised"):
+        normalise(Mesh(np.ones((3, 3)), [[0, 1, 2]]), skeleton)
+
+
+def test_sample_needs_one_weight_row_per_vertex():
+    mesh, skeleton = biped(facing_plus_y=False)
+    weights = Weights(np.ones((3, 1)), ("Hips",))
+    with pytest.raises(InputError, match=f"'Guy': the weights have 3 rows but the mesh has {mesh.vertex_count} vertices"):
+        CharacterSample.from_character("Guy", "biped", mesh, skeleton, weights)
 
 
 def test_long_animals_are_scaled_by_their_longest_side():
@@ -124,13 +131,17 @@ def test_long_animals_are_scaled_by_their_longest_side():
     np.testing.assert_allclose(extent, [1.0, 0.05, 0.05], atol=1e-12)
 
 
-def make_sample(name="Guy", category="biped"):
+#: Loader notes as ``blender.characters`` writes them (one on the bone tails).
+NOTES = ("bone tails derived from the joints: the stored ones are point-like", "12 of 120 vertices have no weight")
+
+
+def make_sample(name="Guy", category="biped", notes=NOTES):
     mesh, skeleton = biped(facing_plus_y=True)
     z = mesh.vertices[:, 2]
     upper = np.clip((z - 1.6) / 0.4, 0.0, 1.0)
     weights = Weights(np.column_stack([1 - upper, upper, np.zeros_like(z), np.zeros_like(z)]),
                       ("Hips", "Chest", "UpperArm.L", "UpperArm.R"))
-    return CharacterSample.from_character(name, category, mesh, skeleton, weights), mesh, weights
+    return CharacterSample.from_character(name, category, mesh, skeleton, weights, notes=notes), mesh, weights
 
 
 def test_sample_round_trip(tmp_path):
@@ -145,21 +156,33 @@ def test_sample_round_trip(tmp_path):
         np.testing.assert_array_equal(getattr(loaded, key), getattr(sample, key))
     assert loaded.names == sample.names and loaded.name == "Guy" and loaded.category == "biped"
     assert loaded.facing == FACING_TURNED and loaded.source_vertex_count == mesh.vertex_count
+    assert loaded.notes == NOTES
     # The stored transform takes the original mesh onto the stored vertices.
     np.testing.assert_allclose(apply_transform(mesh.vertices, loaded.transform), loaded.vertices, atol=1e-12)
     assert loaded.skin.bone_names == ("Hips", "Chest", "UpperArm.L", "UpperArm.R")
 
 
+def test_sample_without_notes_round_trips(tmp_path):
+    sample, _, _ = make_sample(notes=())
+    sample.save(tmp_path / "quiet.npz")
+    assert CharacterSample.load(tmp_path / "quiet.npz").notes == ()
+
+
 def test_loading_another_format_version_is_an_input_error(tmp_path):
+    # Format 2: samples of format 1 (before glTF bone tails were derived from
+    # the joints, and without notes) must be rebuilt.
+    assert SAMPLE_FORMAT_VERSION == 2
     sample, _, _ = make_sample()
     path = tmp_path / "old.npz"
     sample.save(path)
     with np.load(path) as data:
         arrays = dict(data)
-    arrays["format_version"] = np.int64(dataset.SAMPLE_FORMAT_VERSION + 1)
+    arrays["format_version"] = np.int64(1)
     np.savez(path, **arrays)
-    with pytest.raises(InputError, match="format"):
+    with pytest.raises(InputError, match="'old.npz' is a sample of format 1, this version reads 2: delete it"):
         CharacterSample.load(path)
+    with pytest.raises(InputError, match="The sample file '.*missing.npz' does not exist"):
+        CharacterSample.load(tmp_path / "missing.npz")
 
 
 class CountingLoader:
@@ -172,7 +195,8 @@ class CountingLoader:
         self.calls.append((path.name, target_vertices))
         sample, mesh, weights = make_sample(name=path.stem)
         _, skeleton = biped(facing_plus_y=True)
-        return SimpleNamespace(name=path.stem, category="biped", mesh=mesh, skeleton=skeleton, weights=weights)
+        return SimpleNamespace(name=path.stem, category="biped", mesh=mesh, skeleton=skeleton, weights=weights,
+                               notes=NOTES)
 
 
 def character_files(tmp_path, count=2):
@@ -198,6 +222,7 @@ def test_build_samples_caches_and_reuses(tmp_path):
         np.testing.assert_array_equal(built.vertices, cached.vertices)
         np.testing.assert_array_equal(built.weights, cached.weights)
         assert built.name == cached.name
+        assert built.notes == cached.notes == NOTES
     # Other parameters or changed content make new samples.
     build_samples(paths, loader, tmp_path / "cache", target_vertices=1000)
     assert len(loader.calls) == 4
@@ -216,13 +241,13 @@ def test_builds_are_reproducible(tmp_path):
 
 
 def test_cache_folder_follows_the_environment(tmp_path, monkeypatch):
-    monkeypatch.setenv(dataset.CACHE_ENVIRONMENT_VARIABLE, str(tmp_path / "root"))
-    assert dataset.default_cache_dir() == tmp_path / "root" / "samples"
+    monkeypatch.setenv(CACHE_ENVIRONMENT_VARIABLE, str(tmp_path / "root"))
+    assert default_cache_dir() == tmp_path / "root" / "samples"
     paths = character_files(tmp_path, count=1)
     build_samples(paths, CountingLoader())
     assert len(list((tmp_path / "root" / "samples").glob("char0-*.npz"))) == 1
-    monkeypatch.delenv(dataset.CACHE_ENVIRONMENT_VARIABLE)
-    assert dataset.default_cache_dir() == dataset.DEFAULT_CACHE_ROOT.expanduser() / "samples"
+    monkeypatch.delenv(CACHE_ENVIRONMENT_VARIABLE)
+    assert default_cache_dir() == DEFAULT_CACHE_ROOT.expanduser() / "samples"
 
 
 def test_gltf_hash_covers_its_buffer(tmp_path):
@@ -230,13 +255,14 @@ def test_gltf_hash_covers_its_buffer(tmp_path):
     gltf = tmp_path / "c.gltf"
     gltf.write_text(json.dumps(document))
     (tmp_path / "mesh.bin").write_bytes(b"\x00\x01\x02\x03")
-    before = dataset.file_content_hash(gltf)
+    before = file_content_hash(gltf)
     (tmp_path / "mesh.bin").write_bytes(b"\x00\x01\x02\x04")
-    assert dataset.file_content_hash(gltf) != before
+    assert file_content_hash(gltf) != before
 
 
 def test_too_coarse_target_is_an_input_error(tmp_path):
-    with pytest.raises(InputError, match="too coarse"):
+    with pytest.raises(InputError, match=r"A target of 10 vertices is too coarse for a character; use at least 100 "
+                                         r"\(1000 to 5000 suits networks\)"):
         build_samples(character_files(tmp_path, 1), CountingLoader(), tmp_path / "cache", target_vertices=10)
 
 
@@ -248,17 +274,30 @@ def test_data_split_in_both_category_layouts(tmp_path):
     (tmp_path / "two.json").write_text(json.dumps(by_path))
     split = read_data_split(tmp_path / "one.json")
     assert split.validation == ("a/z.glb",) and split.subset("all") == ("a/x.glb", "b/y.glb", "a/z.glb")
-    assert dataset.category_of("b/y.glb", split) == "human"
-    assert dataset.category_of("c/w.glb", split) == "c"
-    assert dataset.category_of("a/x.glb", read_data_split(tmp_path / "two.json")) == "animal"
-    assert dataset.select_split(["a/z.glb", "b/y.glb"], split, "validation") == [0]
-    with pytest.raises(InputError, match="train"):
-        (tmp_path / "bad.json").write_text("[]")
+    assert category_of("b/y.glb", split) == "human"
+    assert category_of("c/w.glb", split) == "c"
+    assert category_of("a/x.glb", read_data_split(tmp_path / "two.json")) == "animal"
+    assert select_split(["a/z.glb", "b/y.glb"], split, "validation") == [0]
+    (tmp_path / "bad.json").write_text("[]")
+    with pytest.raises(InputError, match="'bad.json' must be a JSON object with 'train' and 'validation' lists"):
         read_data_split(tmp_path / "bad.json")
+    (tmp_path / "broken.json").write_text("{")
+    with pytest.raises(InputError, match="'broken.json' is not valid JSON"):
+        read_data_split(tmp_path / "broken.json")
+    with pytest.raises(InputError, match="The data split '.*none.json' does not exist"):
+        read_data_split(tmp_path / "none.json")
+    with pytest.raises(InputError, match="Unknown split 'test': use train, validation or all"):
+        split.subset("test")
 
 
 def test_relative_names(tmp_path):
     path = tmp_path / "pack" / "Fox.glb"
-    assert dataset.relative_name(path, tmp_path) == "pack/Fox"
-    assert dataset.relative_name(path) == "Fox"
-    assert dataset.relative_name(path, tmp_path / "elsewhere") == "Fox"
+    assert relative_name(path, tmp_path) == "pack/Fox"
+    assert relative_name(path) == "Fox"
+    assert relative_name(path, tmp_path / "elsewhere") == "Fox"
+
+
+def test_package_exports_the_public_names():
+    # blender.characters and the eval command use ``core.dataset`` as one namespace.
+    assert dataset.CharacterSample is CharacterSample and dataset.build_samples is build_samples
+    assert dataset.read_data_split is read_data_split and dataset.MIN_TARGET_VERTICES == 100

@@ -1,4 +1,9 @@
-"""The ``eval`` subcommand (autorig_addon.eval_command) on scenes built in code."""
+"""The ``eval`` subcommand (autorig_addon.cli.evaluate) on scenes built in code.
+
+Expected scores are computed independently of the subcommand: by hand, or
+by the core metrics on the fixture's own arrays (the subcommand must report
+exactly what the core measures on the file's content).
+"""
 
 import argparse
 import json
@@ -8,13 +13,15 @@ import bpy
 import numpy as np
 import pytest
 
-from autorig_addon import eval_command
-from autorig_addon.blender import scene_io
-from autorig_addon.core.evaluation.deformation import unique_edges
+from autorig_addon.blender import convert, scene_io
+from autorig_addon.cli import evaluate
+from autorig_addon.cli.main import main
 from autorig_addon.core.errors import InputError
+from autorig_addon.core.evaluation.self_transfer import self_transfer_target
+from autorig_addon.core.evaluation.skin_metrics import evaluate_skin, evaluate_transfer
+from autorig_addon.core.geometry.topology import edges
 from autorig_addon.core.io.rignet_rig import write_rignet_rig
-from autorig_addon.core.evaluation.skin_metrics import evaluate_transfer
-from autorig_addon.core.types import Skeleton, Weights
+from autorig_addon.core.types import Mesh, Skeleton
 from blender_fixtures import (
     BODY_HEIGHT,
     BODY_RADIUS,
@@ -22,6 +29,7 @@ from blender_fixtures import (
     UPPER_BONE,
     box_geometry,
     build_rig_scene,
+    cylinder_geometry,
     expected_body_weights,
     make_sleeve,
     mesh_object,
@@ -29,13 +37,26 @@ from blender_fixtures import (
 )
 
 BODY_SIZE = math.sqrt((2 * BODY_RADIUS) ** 2 * 2 + BODY_HEIGHT ** 2)
-SKIN_KEYS = {"name", "category", "path", "l1", "precision", "recall", "deform_mean", "deform_max", "seconds", "unweighted"}
-RIG_KEYS = {"cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit"}
+#: The reference skeleton of the fixture body, as the subcommand reads it.
+SKELETON = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], (LOWER_BONE, UPPER_BONE), [[0, 0, 1], [0, 0, 2]])
+SKIN_KEYS = {"name", "category", "path", "l1", "precision", "recall", "deform_mean", "deform_max", "unweighted",
+             "seconds", "vertices", "reference_unweighted", "notes"}
+RIG_KEYS = {"name", "category", "path", "cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit", "seconds", "notes"}
+NO_ARMATURE = ("No armature in this file deforms a mesh: a rigged character needs a mesh with an Armature modifier "
+               "(or armature parenting) and vertex groups.")
+
+
+def body_arrays():
+    """The fixture body's vertices (506, 3), triangles and reference weights (506, 2)."""
+    vertices, faces = cylinder_geometry(BODY_RADIUS, 0.0, BODY_HEIGHT, 24, 20, capped=True)
+    triangles = np.array([triangle for face in faces
+                          for triangle in ([face] if len(face) == 3 else [face[:3], (face[0], face[2], face[3])])])
+    return vertices, triangles, expected_body_weights(vertices[:, 2])
 
 
 def parse(arguments):
     parser = argparse.ArgumentParser()
-    eval_command.add_arguments(parser)
+    evaluate.add_arguments(parser)
     return parser.parse_args(arguments)
 
 
@@ -43,7 +64,7 @@ def run_eval(arguments, tmp_path, capsys):
     """Run ``eval`` with a JSON report; returns (exit code, report, stdout)."""
     out = tmp_path / "report.json"
     capsys.readouterr()
-    code = eval_command.run(parse(arguments + ["--out", str(out), "--split-file", str(tmp_path / "no_split.json")]))
+    code = evaluate.run(parse(arguments + ["--out", str(out), "--split-file", str(tmp_path / "no_split.json"), "--quiet"]))
     stdout = capsys.readouterr().out
     return code, json.loads(out.read_text()), stdout
 
@@ -60,16 +81,21 @@ def test_reference_method_scores_perfectly(clean_scene, tmp_path, capsys):
     save_body(tmp_path / "data" / "body.blend")
     code, report, stdout = run_eval(["skin", str(tmp_path / "data"), "--method", "reference"], tmp_path, capsys)
     assert code == 0
-    assert report["task"] == "skin" and report["method"] == "reference"
+    assert (report["task"], report["method"]) == ("skin", "reference")
     (entry,) = report["characters"]
-    assert SKIN_KEYS <= set(entry)
-    assert entry["name"] == "body" and entry["category"] == "data"
-    assert entry["l1"] == 0.0 and entry["precision"] == 1.0 and entry["recall"] == 1.0
-    assert entry["deform_mean"] == 0.0 and entry["deform_max"] == 0.0 and entry["unweighted"] == 0
-    overall = report["summary"]["overall"]
-    assert overall["count"] == 1 and overall["failed"] == 0 and overall["mean"]["l1"] == 0.0
-    assert report["summary"]["categories"]["data"]["median"]["recall"] == 1.0
-    assert "| body | 0 | 1 | 1 | 0 | 0 | 0 |" in stdout and "**overall**" in stdout
+    assert set(entry) == SKIN_KEYS
+    assert entry == {
+        "name": "body", "category": "data", "path": str(tmp_path / "data" / "body.blend"),
+        "l1": 0.0, "precision": 1.0, "recall": 1.0, "deform_mean": 0.0, "deform_max": 0.0, "unweighted": 0,
+        "seconds": 0.0, "vertices": 506, "reference_unweighted": 0, "notes": [],
+    }
+    statistics = {"count": 1, "failed": 0,
+                  "mean": {"l1": 0.0, "precision": 1.0, "recall": 1.0, "deform_mean": 0.0, "deform_max": 0.0,
+                           "unweighted": 0.0, "seconds": 0.0}}
+    statistics["median"] = dict(statistics["mean"])
+    assert report["summary"] == {"categories": {"data": statistics}, "overall": statistics}
+    assert "| body | 0 | 1 | 1 | 0 | 0 | 0 | 0 |" in stdout
+    assert "| **overall** | 1 | 0 | 0 / 0 | 1 / 1 | 1 / 1 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 |" in stdout
 
 
 def test_nearest_bone_has_the_hand_computed_error(clean_scene, tmp_path, capsys):
@@ -80,41 +106,44 @@ def test_nearest_bone_has_the_hand_computed_error(clean_scene, tmp_path, capsys)
     # Rings every 0.1 in z, 24 vertices each, 506 vertices in all. Reference
     # Upper weights 0.25, 0.5, 0.75 at z = 0.9, 1.0, 1.1; nearest bone gives
     # Lower, Lower (tie, first bone), Upper: row errors 0.5, 1.0, 0.5.
-    assert entry["l1"] == pytest.approx(24 * (0.5 + 1.0 + 0.5) / 506, abs=1e-6)
+    assert entry["l1"] == pytest.approx(24 * (0.5 + 1.0 + 0.5) / 506, abs=1e-12)
     # Every bone the vertex has is a reference bone; the blend rings lose one.
-    assert entry["precision"] == pytest.approx(1.0)
-    assert entry["recall"] == pytest.approx(506 / (506 + 3 * 24), abs=1e-9)
-    assert entry["deform_mean"] > 0.0 and entry["deform_max"] > entry["deform_mean"]
+    assert entry["precision"] == 1.0
+    assert entry["recall"] == pytest.approx(506 / (506 + 3 * 24), abs=1e-12)
+    assert entry["unweighted"] == 0
+    # The deformation error is the core's on the same one-hot weights
+    # (Lower up to z = 1, Upper above), under the same seeded poses.
+    vertices, _, reference = body_arrays()
+    one_hot = np.column_stack([vertices[:, 2] <= 1.0, vertices[:, 2] > 1.0]).astype(float)
+    expected = evaluate_skin(vertices, one_hot, reference, SKELETON)
+    assert expected["deform_max"] > 10 * expected["deform_mean"] > 0  # the answer is not trivially zero
+    assert entry["deform_mean"] == pytest.approx(expected["deform_mean"], rel=1e-6)
+    assert entry["deform_max"] == pytest.approx(expected["deform_max"], rel=1e-6)
 
 
-def test_boneheat_runs_on_a_copy_and_counts_unweighted(clean_scene, tmp_path, capsys):
+def test_boneheat_scores_blenders_own_automatic_weights(clean_scene, tmp_path, capsys):
     save_body(tmp_path / "body.blend")
     code, report, _ = run_eval(["skin", str(tmp_path / "body.blend"), "--method", "boneheat"], tmp_path, capsys)
     assert code == 0
     (entry,) = report["characters"]
-    assert entry["unweighted"] == 0
-    # Heat spreads the joint more widely than the artist's 0.4 band but keeps
-    # each end wholly on its bone: a small, non-zero error.
-    assert 0.0 < entry["l1"] < 0.5 and entry["recall"] > 0.9
-
-
-def test_unweighted_prediction_stays_at_rest_in_the_deformation_error():
-    vertices = np.array([[0.0, 0.0, 0.5], [0.0, 0.0, 1.5], [0.2, 0.0, 1.5]])
-    skeleton = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], ("a", "b"), [[0, 0, 1], [0, 0, 2]])
-    reference = Weights(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 1.0]]), ("a", "b"))
-    predicted = Weights(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), ("a", "b"))
-    # One pose: bone b turns 90 degrees about x at its head (0, 0, 1).
-    poses = np.broadcast_to(np.eye(3), (1, 2, 3, 3)).copy()
-    poses[0, 1] = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]
-    scores = eval_command.skin_scores(vertices, predicted, reference, skeleton, poses)
-    assert scores["unweighted"] == 1
-    # The unweighted vertex stays at (0.2, 0, 1.5); the reference moves it to
-    # (0.2, -0.5, 1.0): 0.5 * sqrt(2) apart. Mean over the three vertices.
-    size = np.linalg.norm(vertices.max(0) - vertices.min(0))
-    assert scores["deform_max"] == pytest.approx(0.5 * math.sqrt(2) / size)
-    assert scores["deform_mean"] == pytest.approx(0.5 * math.sqrt(2) / size / 3)
-    assert scores["l1"] == pytest.approx(1.0 / 3)
-    assert scores["precision"] == 1.0 and scores["recall"] == pytest.approx(2.0 / 3)
+    # The same mesh without any vertex group, parented with Automatic Weights here.
+    scene_io.load_scene(tmp_path / "body.blend")
+    vertices, triangles, reference = body_arrays()
+    copy = mesh_object("Copy", vertices, triangles.tolist())
+    armature = bpy.data.objects["Armature"]
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj in (copy, armature))
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
+    heat = convert.read_weights(copy, [LOWER_BONE, UPPER_BONE]).matrix
+    expected = evaluate_skin(vertices, heat, reference, SKELETON)
+    assert expected["l1"] > 0.01  # heat spreads the joint wider than the artist's band
+    for key in ("l1", "precision", "recall", "deform_mean", "deform_max"):
+        assert entry[key] == pytest.approx(expected[key], rel=1e-5), key
+    assert entry["unweighted"] == expected["unweighted"] == 0
+    # The file's own groups stayed out of it: the body still has the artist's weights.
+    body = bpy.data.objects["Body"]
+    np.testing.assert_allclose(convert.read_weights(body, [LOWER_BONE, UPPER_BONE]).matrix, reference, atol=1e-6)
 
 
 def test_one_failure_does_not_stop_the_evaluation(clean_scene, tmp_path, capsys):
@@ -125,10 +154,11 @@ def test_one_failure_does_not_stop_the_evaluation(clean_scene, tmp_path, capsys)
     code, report, stdout = run_eval(["skin", str(tmp_path / "data"), "--method", "nearest_bone"], tmp_path, capsys)
     assert code == 1
     body, rock = report["characters"]
-    assert "error" not in body and body["l1"] > 0
-    assert "No armature" in rock["error"] and "l1" not in rock
+    assert body["l1"] == pytest.approx(24 * 2.0 / 506, abs=1e-12) and "error" not in body
+    assert rock == {"name": "b_rock", "category": "data", "path": str(tmp_path / "data" / "b_rock.blend"),
+                    "error": NO_ARMATURE}
     assert report["summary"]["overall"]["count"] == 1 and report["summary"]["overall"]["failed"] == 1
-    assert "| b_rock | failed: No armature" in stdout
+    assert f"| b_rock | failed: {NO_ARMATURE} |" in stdout
 
 
 def test_split_filters_the_data(clean_scene, tmp_path, capsys):
@@ -138,14 +168,17 @@ def test_split_filters_the_data(clean_scene, tmp_path, capsys):
              "categories": {"biped": ["pack/kept.blend", "pack/dropped.blend"]}}
     (tmp_path / "split.json").write_text(json.dumps(split))
     arguments = ["skin", str(tmp_path / "chars"), "--method", "reference", "--split", "validation",
-                 "--split-file", str(tmp_path / "split.json")]
+                 "--split-file", str(tmp_path / "split.json"), "--quiet"]
     out = tmp_path / "r.json"
-    assert eval_command.run(parse(arguments + ["--out", str(out)])) == 0
+    assert evaluate.run(parse(arguments + ["--out", str(out)])) == 0
     report = json.loads(out.read_text())
     assert [(c["name"], c["category"]) for c in report["characters"]] == [("pack/kept", "biped")]
-    with pytest.raises(InputError, match="validation"):
-        eval_command.collect_data([str(tmp_path / "chars" / "pack" / "dropped.blend")], "validation",
-                                  str(tmp_path / "split.json"))
+    dropped = tmp_path / "chars" / "pack" / "dropped.blend"
+    with pytest.raises(InputError, match=(
+        rf"^No file under {dropped} is in the 'validation' split of split\.json \(its paths are relative to the "
+        r"characters folder\): pass that folder, or use --split all\.$"
+    )):
+        evaluate.collect_data([str(dropped)], "validation", str(tmp_path / "split.json"))
 
 
 def test_rig_from_files_equal_to_the_reference(clean_scene, tmp_path, capsys):
@@ -159,15 +192,17 @@ def test_rig_from_files_equal_to_the_reference(clean_scene, tmp_path, capsys):
     code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{exact}"], tmp_path, capsys)
     assert code == 0
     (entry,) = report["characters"]
-    assert RIG_KEYS <= set(entry)
-    assert entry["cd_j2j"] == 0.0 and entry["cd_j2b"] == 0.0 and entry["iou"] == 1.0 and entry["tree_edit"] == 0
+    assert set(entry) == RIG_KEYS
+    assert (entry["cd_j2j"], entry["cd_j2b"], entry["iou"], entry["precision"], entry["recall"], entry["tree_edit"]) == (
+        0.0, 0.0, 1.0, 1.0, 1.0, 0)
     _, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{shifted}"], tmp_path, capsys)
     (entry,) = report["characters"]
     # Every joint is 0.05 from its counterpart: the Chamfer distance is 0.05 / size.
     assert entry["cd_j2j"] == pytest.approx(0.05 / BODY_SIZE, rel=1e-6)
     assert entry["iou"] == 1.0  # within the matching tolerance of 0.025 * size
-    _, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{tmp_path}"], tmp_path, capsys)
-    assert "No predicted rig" in report["characters"][0]["error"]
+    code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{tmp_path}"], tmp_path, capsys)
+    assert code == 1
+    assert report["characters"][0]["error"] == f"No predicted rig for 'body' in '{tmp_path}' (looked for body.txt)."
 
 
 def test_transfer_onto_a_sleeve_and_self_transfer(clean_scene, tmp_path, capsys):
@@ -183,19 +218,18 @@ def test_transfer_onto_a_sleeve_and_self_transfer(clean_scene, tmp_path, capsys)
     )
     assert code == 0
     garment, self_check = report["characters"]
-    assert garment["kind"] == "garment" and "deform_mean" not in garment
+    assert (garment["kind"], garment["vertices"]) == ("garment", len(sleeve_vertices)) and "deform_mean" not in garment
     # The sleeve's closest body points lie at its own heights, where the body's
     # weights are linear between rings: the transfer gives the exact blend.
     triangles = np.vstack([sleeve_quads[:, [0, 1, 2]], sleeve_quads[:, [0, 2, 3]]])
-    skeleton = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], (LOWER_BONE, UPPER_BONE), [[0, 0, 1], [0, 0, 2]])
-    expected = evaluate_transfer(sleeve_vertices, unique_edges(triangles), expected_body_weights(sleeve_vertices[:, 2]),
-                                 skeleton)
+    expected = evaluate_transfer(sleeve_vertices, edges(triangles), expected_body_weights(sleeve_vertices[:, 2]), SKELETON)
+    assert expected["stretch_max"] > 0.0
     assert garment["stretch_p99"] == pytest.approx(expected["stretch_p99"], rel=1e-4)
     assert garment["stretch_max"] == pytest.approx(expected["stretch_max"], rel=1e-4)
-    assert garment["stretch_max"] > 0.0
     # Self-transfer: the body pushed out along its normals gets its own weights back.
-    assert self_check["kind"] == "self"
-    assert self_check["deform_mean"] < 1e-6 and self_check["deform_max"] < 1e-5
+    assert (self_check["kind"], self_check["vertices"]) == ("self", 506)
+    assert self_check["deform_mean"] == pytest.approx(0.0, abs=1e-6)
+    assert self_check["deform_max"] == pytest.approx(0.0, abs=1e-5)
 
 
 def test_robust_transfer_self_check(clean_scene, tmp_path, capsys):
@@ -203,8 +237,16 @@ def test_robust_transfer_self_check(clean_scene, tmp_path, capsys):
     code, report, stdout = run_eval(["transfer", str(tmp_path / "body.blend"), "--method", "robust"], tmp_path, capsys)
     assert code == 0
     (entry,) = report["characters"]
-    assert entry["kind"] == "self" and entry["deform_mean"] < 1e-3
-    assert "stretch_p99" in stdout
+    # Every vertex of the offset body is copied from the body: its own weights,
+    # so the stretch is that of the reference weights on the offset surface.
+    vertices, triangles, reference = body_arrays()
+    target = self_transfer_target(Mesh(vertices, triangles), BODY_SIZE)
+    expected = evaluate_transfer(target.vertices, edges(target.triangles), reference, SKELETON, reference)
+    assert (entry["kind"], entry["deform_mean"], entry["deform_max"]) == ("self", 0.0, 0.0)
+    assert entry["stretch_p99"] == pytest.approx(expected["stretch_p99"], rel=1e-5)
+    assert entry["stretch_max"] == pytest.approx(expected["stretch_max"], rel=1e-5)
+    assert "| character | stretch_p99 | stretch_max | deform_mean | deform_max | seconds |" in stdout
+    assert f"| body | {entry['stretch_p99']:.4g} | {entry['stretch_max']:.4g} | 0 | 0 |" in stdout
 
 
 def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
@@ -212,17 +254,34 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
     make_sleeve(with_button=False)
     scene_io.save_scene(tmp_path / "sleeve.blend")
     code, report, _ = run_eval(["transfer", str(tmp_path / "sleeve.blend"), "--method", "robust"], tmp_path, capsys)
-    assert code == 1 and "--source" in report["characters"][0]["error"]
+    assert code == 1
+    assert report["characters"][0]["error"] == "'sleeve' is not rigged, so it is a garment: give the body with --source."
 
 
 @pytest.mark.parametrize(
     ("task", "method", "message"),
-    [("skin", "magic", "Unknown skin method"), ("rig", "file:/no/such/folder", "does not exist"),
-     ("rig", "oracle", "Unknown rig method"), ("transfer", "copy", "Unknown transfer method")],
+    [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'nearest_bone', 'reference']."),
+     ("rig", "file:/no/such/folder", "The folder of predicted rigs '/no/such/folder' does not exist."),
+     ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of none yet."),
+     ("transfer", "copy", "Unknown transfer method 'copy': use one of ['closest_point', 'robust'].")],
 )
-def test_unknown_methods_are_input_errors(task, method, message):
-    with pytest.raises(InputError, match=message):
-        eval_command.check_method(task, method)
+def test_unknown_methods_are_usage_errors(task, method, message, tmp_path, capsys):
+    with pytest.raises(InputError) as raised:
+        evaluate.check_method(task, method)
+    assert str(raised.value) == message
+    capsys.readouterr()
+    # Through the command line: exit 2 before any file is read (the data need not exist).
+    assert main(["eval", task, str(tmp_path / "nothing.blend"), "--method", method]) == 2
+    assert capsys.readouterr().err == f"error: {message}\n"
+
+
+def test_no_data_is_a_usage_error(tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    capsys.readouterr()
+    assert main(["eval", "skin", str(tmp_path / "empty"), "--method", "reference"]) == 2
+    assert capsys.readouterr().err == f"error: No loadable file found in {tmp_path / 'empty'}.\n"
+    assert main(["eval", "skin", str(tmp_path / "missing"), "--method", "reference"]) == 2
+    assert capsys.readouterr().err == f"error: '{tmp_path / 'missing'}' is neither a file nor a folder.\n"
 
 
 def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys, monkeypatch):
@@ -234,7 +293,7 @@ def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys,
         top = mesh.vertices[:, 2].max()
         return Skeleton([[0, 0, 0], [0, 0, top / 2]], [-1, 0], ("root", "mid"))
 
-    monkeypatch.setitem(eval_command.RIG_METHODS, "halves", eval_command.Method(predict, "test"))
+    monkeypatch.setitem(evaluate.RIG_METHODS, "halves", evaluate.Method(predict, "test"))
     code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", "halves"], tmp_path, capsys)
     assert code == 0 and len(seen) == 1 and seen[0].vertex_count == 506
     assert report["characters"][0]["cd_j2j"] == 0.0
@@ -243,24 +302,28 @@ def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys,
 def test_json_on_stdout(clean_scene, tmp_path, capsys):
     save_body(tmp_path / "body.blend")
     capsys.readouterr()  # what saving the fixture printed
-    code = eval_command.run(parse(["skin", str(tmp_path / "body.blend"), "--method", "reference", "--format", "json",
-                                   "--split-file", str(tmp_path / "none.json"), "--quiet"]))
-    captured = capsys.readouterr().out
-    report = json.loads(captured)
-    assert code == 0 and report["characters"][0]["l1"] == 0.0
+    code = evaluate.run(parse(["skin", str(tmp_path / "body.blend"), "--method", "reference", "--format", "json",
+                               "--split-file", str(tmp_path / "none.json"), "--quiet"]))
+    report = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert (report["task"], report["method"], [entry["l1"] for entry in report["characters"]]) == ("skin", "reference", [0.0])
 
 
 def test_baseline_report_is_shown_beside(clean_scene, tmp_path, capsys):
     save_body(tmp_path / "data" / "body.blend")
-    _, _, _ = run_eval(["skin", str(tmp_path / "data"), "--method", "reference"], tmp_path, capsys)
+    run_eval(["skin", str(tmp_path / "data"), "--method", "reference"], tmp_path, capsys)
     (tmp_path / "report.json").rename(tmp_path / "reference.json")
     code, _, stdout = run_eval(["skin", str(tmp_path / "data" / "body.blend"), "--method", "nearest_bone",
                                 "--baseline", str(tmp_path / "reference.json")], tmp_path, capsys)
     assert code == 0
-    # Matched by file, although the names differ (folder vs file input).
+    # Matched by file, although the names differ (folder vs file input):
+    # l1 = 48 / 506, recall = 506 / 578 beside the reference's 0 and 1.
     assert "| body | 0.09486 / 0 | 1 / 1 | 0.8754 / 1 |" in stdout
     assert "### Summary (mean: nearest_bone / reference)" in stdout
-    with pytest.raises(InputError, match="not a report"):
-        (tmp_path / "wrong.json").write_text(json.dumps({"task": "rig", "characters": []}))
-        eval_command.run(parse(["skin", str(tmp_path / "data"), "--method", "reference",
-                                "--baseline", str(tmp_path / "wrong.json")]))
+    (tmp_path / "wrong.json").write_text(json.dumps({"task": "rig", "characters": []}))
+    capsys.readouterr()
+    assert main(["eval", "skin", str(tmp_path / "data"), "--method", "reference",
+                 "--baseline", str(tmp_path / "wrong.json")]) == 2
+    assert capsys.readouterr().err == (
+        f"error: '{tmp_path / 'wrong.json'}' is not a report of an 'skin' evaluation (write one with --out).\n"
+    )

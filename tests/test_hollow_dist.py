@@ -1,21 +1,22 @@
 """HollowDist vertex-to-bone distances on shapes with known answers."""
 
+import re
+
 import numpy as np
 import pytest
-from geometry_fixtures import cylinder
-from test_volumetric_geodesic import vertex_index
-from test_voxelize import box_mesh, plain_grid
+from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, plain_grid, vertex_index
 
-from autorig_addon.core.errors import InputError
+from autorig_addon.core.distances.cell_graph import bone_node_distances
 from autorig_addon.core.distances.hollow_dist import build_hollow_graph, hollow_distances
-from autorig_addon.core.geometry.segments import point_segment_distances
-from autorig_addon.core.types import Mesh
-from autorig_addon.core.distances.voxelize import (
-    STAIRCASE_RATIO,
-    bone_node_distances,
+from autorig_addon.core.distances.line_of_sight import STAIRCASE_RATIO
+from autorig_addon.core.distances.vertex_distances import (
+    UNREACHABLE_PENALTY,
     combine_vertex_distances,
     vertex_cell_candidates,
 )
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.geometry.segments import point_segment_distances
+from autorig_addon.core.types import Mesh
 
 
 def test_convex_shape_gives_straight_distances():
@@ -37,7 +38,9 @@ def test_hand_checked_wall_counts_a_layer_and_keeps_the_length():
     raw = bone_node_distances(graph, np.array(blocks))[:, 0]
     # Entering the wall is free, leaving it costs one layer.
     np.testing.assert_allclose(raw, [0, 2, 4, 6 + graph.layer_cost], atol=1e-9)
-    assert graph.layer_cost > 6.5  # above any path length in this grid
+    # Above any path: 4 nodes x the longest step (2) + the longest bone edge (0)
+    # + 4 cells, rounded up to a power of two.
+    assert graph.layer_cost == 16.0
     beyond = np.array([[7.5, 1.0, 1.0]])
     candidates, query = vertex_cell_candidates(graph, beyond)
     distance, layers = combine_vertex_distances(graph, beyond, candidates, query, bone_node_distances(graph, query))
@@ -80,24 +83,27 @@ def test_open_sheet_is_a_wall_paths_go_around():
 
 
 def test_disconnected_part_gets_finite_distances_through_the_air():
-    body = cylinder(radius=0.2, height=1.0, segments=32, rings=21)
-    hat = box_mesh([-0.15, -0.15, 1.1], [0.15, 0.15, 1.3], 0.05)
-    mesh = Mesh.concatenate([body, hat])
-    heads = np.array([[0, 0, 0.05], [0, 0, 0.6]])
-    tails = np.array([[0, 0, 0.6], [0, 0, 0.95]])
+    mesh, hat_vertices, heads, tails = body_with_hat()
     cell = 1.3 / 88
     distances = hollow_distances(mesh, heads, tails, resolution=88)
     assert np.all(np.isfinite(distances))
-    hat_vertices = np.arange(body.vertex_count, mesh.vertex_count)
     assert np.all(distances[hat_vertices, 1] < distances[hat_vertices, 0])
     # Straight up out of the body, across the gap: 0.15 from the bone's tip.
     brim_centre = vertex_index(mesh, [0, 0, 1.1])
     assert distances[brim_centre, 1] == pytest.approx(0.15, abs=3 * cell)
 
 
-def test_bad_bones_are_rejected():
+@pytest.mark.parametrize("heads, tails, message", BAD_BONES)
+def test_bad_bones_are_rejected(heads, tails, message):
     mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
-    with pytest.raises(InputError, match="No bones"):
-        hollow_distances(mesh, np.zeros((0, 3)), np.zeros((0, 3)))
-    with pytest.raises(InputError, match="head and one tail"):
-        hollow_distances(mesh, np.zeros((2, 3)), np.ones((1, 3)))
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
+        hollow_distances(mesh, heads, tails)
+
+
+def test_vertex_in_no_face_outside_the_grid_gets_the_documented_fallback():
+    body = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
+    stray = np.array([[5.0, 0.5, 0.5]])
+    mesh = Mesh(np.vstack([body.vertices, stray]), body.triangles)
+    heads, tails = np.array([[0.5, 0.5, 0.2]]), np.array([[0.5, 0.5, 0.8]])
+    distances = hollow_distances(mesh, heads, tails, resolution=20)
+    assert distances[-1, 0] == pytest.approx(UNREACHABLE_PENALTY * 4.5)  # 4.5 straight to the bone

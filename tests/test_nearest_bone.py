@@ -1,4 +1,6 @@
-"""Nearest-bone weights (autorig_addon.core.nearest_bone), numbers by hand."""
+"""Nearest-bone weights (autorig_addon.core.skinning.nearest_bone), numbers by hand."""
+
+import re
 
 import numpy as np
 import pytest
@@ -27,20 +29,20 @@ def test_two_bone_cylinder_splits_at_the_joint():
 
 def test_non_deform_bones_get_no_column():
     skeleton = Skeleton(
-        joints=[[0, 0, 0], [0, 0, 0.5], [0.0, 0.0, 0.2]], parents=[-1, 0, 0], names=("lower", "upper", "control"),
-        tails=[[0, 0, 0.5], [0, 0, 1.0], [0.0, 0.0, 0.3]], deform=[True, True, False],
+        joints=[[0, 0, 0], [0, 0, 0.5], [0.05, 0.0, 0.2]], parents=[-1, 0, 0], names=("lower", "upper", "control"),
+        tails=[[0, 0, 0.5], [0, 0, 1.0], [0.05, 0.0, 0.3]], deform=[True, True, False],
     )
     mesh = cylinder(radius=0.1, height=1.0, segments=6, rings=11)
     weights = nearest_bone_weights(mesh, skeleton)
     assert weights.bone_names == ("lower", "upper")
-    # The control bone sits inside the lower half; without it the lower half still goes to "lower".
-    z = mesh.vertices[:, 2]
-    assert np.all(weights.matrix[z < 0.45, 0] == 1.0)
-
-
+    # The control bone is 0.05 from the +x side vertices at z = 0.2 and 0.3
+    # ("lower" is 0.1 away); without a column it changes nothing.
+    assert np.sum(np.isclose(mesh.vertices[:, 0], 0.1) & (np.abs(mesh.vertices[:, 2] - 0.25) < 0.06)) == 2
+    np.testing.assert_array_equal(weights.matrix, nearest_bone_weights(mesh, two_bone_skeleton()).matrix)
 
 
 def test_skeleton_without_deform_bones_is_an_input_error():
     skeleton = Skeleton([[0, 0, 0]], [-1], ("only",), [[0, 0, 1]], [False])
-    with pytest.raises(InputError, match="no deform bones"):
+    message = "The skeleton has no deform bones: turn on Deform for the bones that should move the mesh."
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
         nearest_bone_weights(Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]), skeleton)

@@ -7,10 +7,9 @@ import os
 import numpy as np
 import pytest
 
-from autorig_addon.core.procedural import generator as procedural
 from autorig_addon.core.geometry.closest_point import closest_points_on_triangles
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.procedural.generator import (
+from autorig_addon.core.procedural import (
     KINDS,
     PART_CLOTH,
     PART_DRIVEN,
@@ -18,7 +17,21 @@ from autorig_addon.core.procedural.generator import (
     PART_TYPES,
     ProceduralCharacter,
     generate_character,
+    generate_characters,
 )
+from autorig_addon.core.procedural.character_builder import CharacterBuilder
+from autorig_addon.core.procedural.frames import axis_frame
+from autorig_addon.core.procedural.kinds import BUILDERS
+from autorig_addon.core.procedural.part_weights import (
+    closest_point_weights,
+    joint_blend_weights,
+    stack_weight_blocks,
+    sum_weight_blocks,
+)
+from autorig_addon.core.procedural.polylines import cumulative_lengths, points_at_fractions, resample_polyline
+from autorig_addon.core.procedural.rig_builder import TAIL_SHRINK, RigBuilder, curling_directions, shrinking_lengths
+from autorig_addon.core.procedural.shapes import box_geometry, ellipsoid_geometry, signed_volume
+from autorig_addon.core.procedural.tubes import round_radii, tapered_radii
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SEEDS_PER_KIND = (0, 1, 2, 3, 4, 5)
@@ -90,7 +103,7 @@ def test_variants_of_each_kind_appear():
 
 
 def test_generate_characters_is_the_lazy_sequence_of_seeds():
-    lazy = list(procedural.generate_characters([4, 9], "fish"))
+    lazy = list(generate_characters([4, 9], "fish"))
     for character, seed in zip(lazy, (4, 9)):
         np.testing.assert_array_equal(character.mesh.vertices, generate_character(seed, "fish").mesh.vertices)
         assert character.seed == seed
@@ -254,7 +267,7 @@ def test_body_vertices_blend_only_a_bone_and_its_parent(samples):
 def test_joint_blend_weights_are_linear_within_the_joint_region():
     joint_arc = np.array([0.0, 1.0, 3.0])
     arc = np.array([0.5, 0.875, 1.0, 1.125, 1.25, 2.0, 3.0])
-    weights = procedural._joint_blend_weights(arc, joint_arc, 0.25, False, False)
+    weights = joint_blend_weights(arc, joint_arc, 0.25, False, False)
     # Half-width at the joint: 0.25 x the shorter bone (1.0) = 0.25.
     expected_first = np.array([1.0, 0.75, 0.5, 0.25, 0.0, 0.0, 0.0])
     np.testing.assert_allclose(weights[:, 0], expected_first, atol=1e-15)
@@ -263,7 +276,7 @@ def test_joint_blend_weights_are_linear_within_the_joint_region():
 
 def test_joint_blend_weights_with_parent_and_child():
     joint_arc = np.array([0.0, 2.0])
-    weights = procedural._joint_blend_weights(np.array([0.0, 0.25, 1.0, 2.0]), joint_arc, 0.25, True, True)
+    weights = joint_blend_weights(np.array([0.0, 0.25, 1.0, 2.0]), joint_arc, 0.25, True, True)
     # Columns: parent, bone, child; half-width 0.25 x 2.0 = 0.5 at each end.
     np.testing.assert_allclose(weights, [[0.5, 0.5, 0.0], [0.25, 0.75, 0.0], [0.0, 1.0, 0.0], [0.0, 0.5, 0.5]], atol=1e-15)
 
@@ -273,31 +286,31 @@ def test_closest_point_weights_interpolate_the_body():
     triangles = np.array([[0, 1, 2], [0, 2, 3]])
     weights = np.array([[1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.0]])  # first bone at y = 0, second at y = 1
     points = np.array([[0.3, 0.25, 0.4], [0.8, 0.75, -0.2], [0.5, 2.0, 0.1]])
-    result = procedural._closest_point_weights(points, vertices, triangles, weights)
+    result = closest_point_weights(points, vertices, triangles, weights)
     # Weights here vary linearly with y; the last point is closest to the edge y = 1.
     np.testing.assert_allclose(result, [[0.75, 0.25], [0.25, 0.75], [0.0, 1.0]], atol=1e-12)
 
 
 def test_box_has_the_exact_volume_and_corners():
-    vertices, triangles = procedural._box_geometry(np.array([1.0, 2.0, 3.0]), np.array([0.5, 0.25, 2.0]), np.eye(3))
-    assert procedural._signed_volume(vertices, triangles) == pytest.approx(8 * 0.5 * 0.25 * 2.0, rel=1e-12)
+    vertices, triangles = box_geometry(np.array([1.0, 2.0, 3.0]), np.array([0.5, 0.25, 2.0]), np.eye(3))
+    assert signed_volume(vertices, triangles) == pytest.approx(8 * 0.5 * 0.25 * 2.0, rel=1e-12)
     corners = vertices[np.abs(vertices[:, 0] - 1.0) > 1e-9]
     np.testing.assert_allclose(np.abs(corners - [1.0, 2.0, 3.0]), np.tile([0.5, 0.25, 2.0], (len(corners), 1)), atol=1e-12)
 
 
 def test_ellipsoid_vertices_lie_on_the_ellipsoid():
     radii = np.array([0.3, 0.5, 0.9])
-    frame = procedural._frame(np.array([0.0, 1.0, 1.0]), np.array([1.0, 0.0, 0.0]))
+    frame = axis_frame(np.array([0.0, 1.0, 1.0]), np.array([1.0, 0.0, 0.0]))
     centre = np.array([0.1, -0.2, 0.3])
-    vertices, triangles = procedural._ellipsoid_geometry(centre, radii, frame, 0.05)
+    vertices, triangles = ellipsoid_geometry(centre, radii, frame, 0.05)
     local = (vertices - centre) @ frame
     np.testing.assert_allclose(((local / radii) ** 2).sum(axis=1), 1.0, atol=1e-12)
-    volume = procedural._signed_volume(vertices, triangles)
+    volume = signed_volume(vertices, triangles)
     assert 0.9 * (4 / 3) * np.pi * radii.prod() < volume < (4 / 3) * np.pi * radii.prod()
 
 
 def test_straight_tube_rings_have_the_requested_radius():
-    builder = procedural._Character(np.random.default_rng(0))
+    builder = CharacterBuilder(np.random.default_rng(0))
     builder.rig.add("a", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     builder.rig.add("b", [0.0, 0.0, 1.0], [0.0, 0.0, 2.0], "a")
     builder.spacing = 0.1
@@ -315,7 +328,7 @@ def test_straight_tube_rings_have_the_requested_radius():
 
 
 def test_bent_chain_splits_into_two_shells():
-    builder = procedural._Character(np.random.default_rng(0))
+    builder = CharacterBuilder(np.random.default_rng(0))
     builder.rig.add("thigh", [0.0, 0.0, 1.0], [0.0, 0.0, 0.5])
     builder.rig.add("foot", [0.0, 0.0, 0.5], [0.0, -0.5, 0.5], "thigh")
     builder.spacing = 0.05
@@ -335,6 +348,61 @@ def test_bent_chain_splits_into_two_shells():
                     unseen.remove(neighbour)
                     stack.append(neighbour)
     assert shells == 2
+
+
+def test_stacked_weight_blocks_take_the_union_of_bone_names():
+    names, weights = stack_weight_blocks([(("a", "b"), np.array([[0.25, 0.75]])), (("c", "a", "a"), np.array([[0.5, 0.25, 0.25], [1.0, 0.0, 0.0]]))])
+    # Names in first-seen order; a name repeated within a block adds up.
+    assert names == ("a", "b", "c")
+    np.testing.assert_array_equal(weights, [[0.25, 0.75, 0.0], [0.5, 0.0, 0.5], [0.0, 0.0, 1.0]])
+
+
+def test_summed_weight_blocks_add_up_by_bone_name():
+    names, weights = sum_weight_blocks([(("a", "b"), np.array([[0.5, 0.25], [0.0, 0.5]])), (("c", "a"), np.array([[0.125, 0.125], [0.5, 0.0]]))])
+    assert names == ("a", "b", "c")
+    np.testing.assert_array_equal(weights, [[0.625, 0.25, 0.125], [0.0, 0.5, 0.5]])
+
+
+def test_polyline_points_by_arc_length():
+    polyline = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 2.0, 0.0]])  # 3 long, a corner at 1
+    np.testing.assert_array_equal(cumulative_lengths(polyline), [0.0, 1.0, 3.0])
+    np.testing.assert_allclose(resample_polyline(polyline, 4), [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 2, 0]], atol=1e-15)
+    np.testing.assert_allclose(points_at_fractions(polyline, np.array([0.5, 1.0])), [[1.0, 0.5, 0.0], [1.0, 2.0, 0.0]], atol=1e-15)
+
+
+def test_tapered_and_round_radii():
+    np.testing.assert_allclose(tapered_radii(2, (1.0, 0.5), 0.2), [[0.2, 0.2], [0.15, 0.15], [0.1, 0.1]], atol=1e-15)
+    np.testing.assert_array_equal(round_radii([1.0, 0.5], 2.0), [[2.0, 2.0], [1.0, 1.0]])
+
+
+def test_grown_tail_shrinks_and_curls():
+    assert list(shrinking_lengths(3, 7.0, 0.5)) == [4.0, 2.0, 1.0]
+    turned = curling_directions(np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 2.0]), np.pi / 2, 3)
+    np.testing.assert_allclose(turned, [[1, 0, 0], [0, 1, 0], [-1, 0, 0]], atol=1e-15)
+    rig = RigBuilder()
+    rig.add("spine", [0.0, 0.0, 1.0], [0.0, -1.0, 1.0])
+    tail = rig.grow_tail("tail", "spine", [0.0, 0.0, 1.0], np.array([0.0, 1.0, 0.0]), 2.0, 4, 0.0)
+    # Straight (no bend): connected bones along +y, each 0.88 x the one before, 2.0 in all.
+    assert tail == ["tail", "tail.001", "tail.002", "tail.003"]
+    lengths = [rig.length(b) for b in tail]
+    assert sum(lengths) == pytest.approx(2.0, rel=1e-12)
+    np.testing.assert_allclose(np.array(lengths[1:]) / lengths[:-1], TAIL_SHRINK, rtol=1e-12)
+    np.testing.assert_allclose(rig.tail("tail.003"), [0.0, 2.0, 1.0], atol=1e-12)
+
+
+def test_symmetrize_mirrors_left_bones_with_mirrored_parents():
+    rig = RigBuilder()
+    rig.add("spine", [0.0, 0.0, 1.0], [0.0, 0.0, 1.5])
+    rig.add_path(["arm.L", "hand.L"], np.array([[0.2, 0.0, 1.4], [0.5, 0.1, 1.3], [0.7, 0.1, 1.2]]), "spine")
+    rig.symmetrize()
+    assert rig.names == ["spine", "arm.L", "hand.L", "arm.R", "hand.R"]
+    assert rig.parents == [None, "spine", "arm.L", "spine", "arm.R"]
+    np.testing.assert_array_equal(rig.head("hand.R"), [-0.5, 0.1, 1.3])
+    np.testing.assert_array_equal(rig.tail("hand.R"), [-0.7, 0.1, 1.2])
+
+
+def test_every_kind_has_a_builder():
+    assert tuple(BUILDERS) == KINDS
 
 
 # --- clothing and driven parts --------------------------------------------------

@@ -1,5 +1,7 @@
 """RigNet rig_info text format: known files, round trips, malformed input."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -145,20 +147,33 @@ def test_malformed_lines_name_the_line(text, message):
 
 def test_hierarchy_errors():
     joints = "joints a 0 0 0\njoints b 0 0 1\njoints c 0 0 2\njoints d 0 0 3\n"
-    with pytest.raises(InputError, match="several roots"):
+    with pytest.raises(InputError, match=re.escape(
+            "Line 6: several roots ('a' on line 5 and 'b'); a RigNet rig has exactly one root.")):
         read_rignet_rig(joints + "root a\nroot b\nhier a b\nhier b c\nhier c d\n")
     with pytest.raises(InputError, match="exactly one root; joints without a parent: a, c"):
         read_rignet_rig(joints + "root a\nhier a b\nhier c d\n")
-    with pytest.raises(InputError, match="cycle through 'c', 'd'"):
+    with pytest.raises(InputError, match=re.escape(
+            "The joint hierarchy has a cycle through 'c', 'd'; these joints cannot be reached from the root.")):
         read_rignet_rig(joints + "root a\nhier a b\nhier c d\nhier d c\n")
-    with pytest.raises(InputError, match="hierarchy is a cycle"):
+    with pytest.raises(InputError, match=re.escape(
+            "The joint hierarchy is a cycle: every joint has a parent, so none can be the root.")):
         read_rignet_rig(joints + "hier a b\nhier b c\nhier c d\nhier d a\n")
     with pytest.raises(InputError, match="Line 5: joint 'a' is its own parent"):
         read_rignet_rig(joints + "hier a a\n")
     with pytest.raises(InputError, match=r"Line 7: joint 'c' already has parent 'b' \(line 6\)"):
         read_rignet_rig(joints + "root a\nhier b c\nhier a c\n")
-    with pytest.raises(InputError, match="Line 5: root 'b' has a parent"):
+    with pytest.raises(InputError, match=re.escape("Line 5: root 'b' has a parent ('a'); the root must have none.")):
         read_rignet_rig(joints + "root b\nhier a b\nhier b c\nhier c d\n")
+
+
+def test_siblings_keep_file_order_and_a_child_listed_first_moves_after_its_parent():
+    text = ("joints tip 0 0 2\njoints hips 0 0 0\njoints leg_R -1 0 0\njoints leg_L 1 0 0\njoints spine 0 0 1\n"
+            "root hips\nhier spine tip\nhier hips leg_R\nhier hips leg_L\nhier hips spine\n")
+    # Ready after hips: leg_R (2), leg_L (3), spine (4) in file order; tip (0) only after spine.
+    skeleton, _ = read_rignet_rig(text)
+    assert skeleton.names == ("hips", "leg_R", "leg_L", "spine", "tip")
+    np.testing.assert_array_equal(skeleton.parents, [-1, 0, 0, 0, 3])
+    np.testing.assert_array_equal(skeleton.joints[:, 2], [0, 0, 0, 1, 2])
 
 
 def test_root_is_inferred_without_root_line():
@@ -168,7 +183,8 @@ def test_root_is_inferred_without_root_line():
 
 
 def test_missing_file_is_input_error(tmp_path):
-    with pytest.raises(InputError, match="not found"):
+    missing = str(tmp_path / "missing.txt")
+    with pytest.raises(InputError, match=re.escape(f"RigNet rig file not found: {missing!r}.")):
         read_rignet_rig(tmp_path / "missing.txt")
 
 
@@ -177,10 +193,11 @@ def test_write_rejects_what_the_format_cannot_hold():
     with pytest.raises(InputError, match="exactly one root bone, this skeleton has 2 \\(a, b\\)"):
         rignet_rig_text(two_roots)
     spaced = Skeleton(np.eye(3)[:2], [-1, 0], ("upper arm", "b"))
-    with pytest.raises(InputError, match="contains whitespace"):
+    with pytest.raises(InputError, match=re.escape(
+            "Bone name 'upper arm' is empty or contains whitespace, which the RigNet text format cannot store.")):
         rignet_rig_text(spaced)
     chain = Skeleton(np.eye(3)[:2], [-1, 0], ("a", "b"))
     with pytest.raises(InputError, match="missing from the skeleton: z"):
         rignet_rig_text(chain, Weights(np.ones((1, 1)), ("z",)))
-    with pytest.raises(InputError, match="NaN"):
+    with pytest.raises(InputError, match=re.escape("Weights contain NaN or infinite values; clean them before writing.")):
         rignet_rig_text(chain, Weights(np.array([[np.nan, 1.0]]), ("a", "b")))

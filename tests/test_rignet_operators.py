@@ -1,10 +1,19 @@
+"""RigNet rig files through Blender: building armatures, import and export operators."""
+
+import re
+
 import numpy as np
 import pytest
 
+from autorig_addon.blender.operators import rignet
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.io.rignet_rig import read_rignet_rig
 from autorig_addon.core.types import Skeleton
-from blender_fixtures import build_rig_scene, group_weights, select_only
+from blender_fixtures import LOWER_BONE, UPPER_BONE, build_rig_scene, group_weights, make_armature, scene_state, select_only
+
+#: Two joints up z, a root and its child, vertices 0 to 2 skinned.
+TWO_JOINT_RIG = ("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
+                 "skin 0 root 1.0\nskin 1 tip 1.0\nskin 2 root 0.5 tip 0.5\n")
 
 
 def test_build_armature_reproduces_skeleton_in_world_space(clean_scene):
@@ -36,7 +45,7 @@ def test_zero_length_bone_is_refused_and_nothing_is_left(clean_scene):
     skeleton = Skeleton(joints=[[0, 0, 0], [0, 0, 1]], parents=[-1, 0], names=("a", "b"),
                         tails=[[0, 0, 1], [0, 0, 1]])
     before = (len(bpy.data.objects), len(bpy.data.armatures))
-    with pytest.raises(InputError, match="zero length"):
+    with pytest.raises(InputError, match=re.escape("1 bone(s) have zero length (b); Blender cannot keep them.")):
         build_armature(skeleton, "Broken")
     assert (len(bpy.data.objects), len(bpy.data.armatures)) == before
 
@@ -49,8 +58,9 @@ def test_export_then_import_round_trips_bones_and_weights(clean_scene, tmp_path)
     select_only([scene.body], active=scene.body)
     assert bpy.ops.autorig.export_rignet(filepath=path) == {"FINISHED"}
     skeleton, weights = read_rignet_rig(path, vertex_count=len(scene.body.data.vertices))
-    deform_names = [b.name for b in scene.armature.data.bones if b.use_deform]
-    assert set(skeleton.names) == set(deform_names)
+    assert skeleton.names == (LOWER_BONE, UPPER_BONE)
+    np.testing.assert_array_equal(skeleton.parents, [-1, 0])
+    np.testing.assert_allclose(skeleton.joints, [[0, 0, 0], [0, 0, 1]], atol=1e-6)
     np.testing.assert_allclose(weights.matrix, group_weights(scene.body, skeleton.names), atol=1e-6)
 
     # Re-import onto a fresh copy of the body without groups.
@@ -64,6 +74,8 @@ def test_export_then_import_round_trips_bones_and_weights(clean_scene, tmp_path)
     assert bpy.ops.autorig.import_rignet(filepath=path) == {"FINISHED"}
     imported = bpy.data.objects["rig"]
     assert imported.type == "ARMATURE" and copy.parent == imported
+    assert [bone.name for bone in imported.data.bones] == [LOWER_BONE, UPPER_BONE]
+    np.testing.assert_allclose([tuple(bone.head_local) for bone in imported.data.bones], skeleton.joints, atol=1e-6)
     np.testing.assert_allclose(group_weights(copy, skeleton.names), weights.matrix, atol=1e-6)
     assert any(m.type == "ARMATURE" and m.object == imported for m in copy.modifiers)
 
@@ -78,7 +90,9 @@ def test_import_with_wrong_vertex_count_leaves_the_scene_unchanged(clean_scene, 
     small = mesh_object("Small", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     select_only([small], active=small)
     before = sorted(o.name for o in bpy.data.objects)
-    with pytest.raises(RuntimeError, match="vertex"):
+    with pytest.raises(RuntimeError, match=re.escape(
+            "Line 5: vertex index 5 is out of range for a mesh of 3 vertices; "
+            "the rig file does not belong to this mesh.")):
         bpy.ops.autorig.import_rignet(filepath=str(path))
     assert sorted(o.name for o in bpy.data.objects) == before
     assert len(small.vertex_groups) == 0
@@ -90,13 +104,57 @@ def test_import_onto_a_mesh_with_more_vertices_than_the_file_is_refused(clean_sc
     from blender_fixtures import mesh_object
 
     path = tmp_path / "rig.txt"
-    path.write_text("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
-                    "skin 0 root 1.0\nskin 1 tip 1.0\nskin 2 root 0.5 tip 0.5\n")
+    path.write_text(TWO_JOINT_RIG)
     bigger = mesh_object("Bigger", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
     bpy.context.view_layer.update()
     select_only([bigger], active=bigger)
     before = sorted(o.name for o in bpy.data.objects)
-    with pytest.raises(RuntimeError, match="not the mesh the rig was made for"):
+    with pytest.raises(RuntimeError, match=re.escape(
+            "The file weights vertices up to 2, but 'Bigger' has 4 vertices: it is not the mesh the rig was made for.")):
         bpy.ops.autorig.import_rignet(filepath=str(path))
     assert sorted(o.name for o in bpy.data.objects) == before
     assert len(bigger.vertex_groups) == 0
+
+
+def test_import_that_fails_while_writing_leaves_neither_armature_nor_groups(clean_scene, tmp_path, monkeypatch):
+    import bpy
+
+    from blender_fixtures import mesh_object
+
+    path = tmp_path / "rig.txt"
+    path.write_text(TWO_JOINT_RIG)
+    mesh = mesh_object("Triangle", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    bpy.context.view_layer.update()
+    before = scene_state([mesh])
+    real_write = rignet.write_weights
+
+    def write_then_fail(obj, weights, armature, **kwargs):
+        real_write(obj, weights, armature, **kwargs)  # groups, modifier and parent are in place...
+        raise RuntimeError("disk full")  # ...when the write fails
+
+    monkeypatch.setattr(rignet, "write_weights", write_then_fail)
+    with pytest.raises(RuntimeError, match="disk full"):
+        rignet.import_rignet_rig(bpy.context, str(path), mesh)
+    assert scene_state([mesh]) == before
+    assert "rig" not in bpy.data.objects and "rig" not in bpy.data.armatures
+
+
+def test_import_without_a_mesh_builds_the_armature_alone(clean_scene, tmp_path):
+    import bpy
+
+    path = tmp_path / "alone.txt"
+    path.write_text(TWO_JOINT_RIG)
+    armature = rignet.import_rignet_rig(bpy.context, str(path))
+    assert armature.name == "alone"
+    assert [(bone.name, bone.parent.name if bone.parent else None) for bone in armature.data.bones] == [
+        ("root", None), ("tip", "root")]
+    np.testing.assert_allclose([tuple(bone.head_local) for bone in armature.data.bones], [[0, 0, 0], [0, 0, 1]])
+
+
+def test_export_refuses_an_armature_without_deform_bones(clean_scene, tmp_path):
+    armature = make_armature("Controls", deform_upper=False)
+    armature.data.bones[LOWER_BONE].use_deform = False
+    path = tmp_path / "rig.txt"
+    with pytest.raises(InputError, match="^'Controls' has no deform bones to export.$"):
+        rignet.export_rignet_rig(str(path), armature)
+    assert not path.exists()

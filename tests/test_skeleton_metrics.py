@@ -286,11 +286,13 @@ def test_tree_edit_is_invariant_to_joint_order():
 
 
 def test_tree_edit_rejects_bad_matching():
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="The matching uses a reference joint twice; it must be one-to-one"):
         tree_edit_distance([-1, 0], [-1, 0], [0, 0])
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="The matching has 1 entries for 2 predicted joints"):
         tree_edit_distance([-1, 0], [-1, 0], [0])
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="The matching refers to a reference joint that does not exist"):
+        tree_edit_distance([-1, 0], [-1, 0], [0, 2])
+    with pytest.raises(InputError, match="A labelled tree edit distance needs the joint matching"):
         tree_edit_distance([-1, 0], [-1, 0], labelled=True)
 
 
@@ -369,8 +371,14 @@ def test_evaluate_rig_extra_leaf_joint():
 
 
 def test_evaluate_rig_rejects_bad_input():
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="The character size must be a positive length, got 0.0"):
         evaluate_rig(small_humanoid(), small_humanoid(), size=0.0)
+    with pytest.raises(InputError, match="The character size must be a positive length, got nan"):
+        chamfer_j2j(np.zeros((1, 3)), np.zeros((1, 3)), size=float("nan"))
     no_deform = skeleton([[0.0, 0.0, 0.0]], [-1], deform=[False])
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="The predicted skeleton has no deform bones; mark the bones that move"):
         evaluate_rig(no_deform, small_humanoid(), size=2.0)
+    with pytest.raises(InputError, match=r"The predicted joints must be an \(n, 3\) array, got shape \(2, 2\)"):
+        chamfer_j2j(np.zeros((2, 2)), np.zeros((1, 3)))
+    with pytest.raises(InputError, match="The bone sample spacing must be positive, got 0.0"):
+        sample_bones(np.zeros((1, 2, 3)), 0.0)

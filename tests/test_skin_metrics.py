@@ -1,9 +1,13 @@
+"""Skin metrics (autorig_addon.core.evaluation.skin_metrics): what ``eval skin`` prints."""
+
+import math
+
 import numpy as np
 import pytest
 
-from autorig_addon.core.evaluation.deformation import axis_angle_matrices, random_poses
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.evaluation.skin_metrics import evaluate_skin, evaluate_transfer, influence_precision_recall, skin_l1
+from autorig_addon.core.skeleton.posing import axis_angle_matrices, random_poses
 from autorig_addon.core.types import Skeleton, Weights
 
 
@@ -70,9 +74,9 @@ def test_empty_prediction_has_zero_precision_and_recall():
 
 
 def test_mismatched_shapes_are_rejected():
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=r"Predicted weights \(2, 3\) and reference weights \(2, 2\) must both be"):
         skin_l1(np.zeros((2, 3)), np.zeros((2, 2)))
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=r"Predicted weights \(3, 2\) and reference weights \(2, 2\) must both be"):
         influence_precision_recall(np.zeros((3, 2)), np.zeros((2, 2)))
 
 
@@ -81,7 +85,9 @@ def test_evaluate_skin_identical_weights():
     vertices = np.array([[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [4.0, 1.0, 1.0]])
     weights = np.array([[1.0, 0.0], [0.4, 0.6], [0.0, 1.0]])
     result = evaluate_skin(vertices, weights, weights, skeleton)
-    assert result == {"l1": 0.0, "precision": 1.0, "recall": 1.0, "deform_mean": 0.0, "deform_max": 0.0}
+    assert result == {
+        "l1": 0.0, "precision": 1.0, "recall": 1.0, "deform_mean": 0.0, "deform_max": 0.0, "unweighted": 0,
+    }
 
 
 def test_evaluate_skin_hand_computed():
@@ -122,8 +128,59 @@ def test_evaluate_skin_uses_only_deform_bones():
     pred = np.array([[0.0, 1.0], [1.0, 0.0]])
     result = evaluate_skin(vertices, pred, ref, skeleton, quarter_turn_of_first_bone())
     assert result["deform_max"] == pytest.approx(np.sqrt(2.0))
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=r"The predicted weights have shape \(2, 3\) but the mesh has 2 vertices "
+                                         r"and the skeleton 2 deform bones"):
         evaluate_skin(vertices, np.ones((2, 3)) / 3, np.ones((2, 3)) / 3, skeleton)
+
+
+def test_evaluate_skin_worked_example():
+    # Bone 'turning' (head at the origin) turns a quarter about z; 'still'
+    # stays. Rows are normalised before anything is measured.
+    #
+    # vertex    rest     ref       pred (normalised)   ref posed   pred posed      distance    L1
+    # 0         (2,0,0)  (1, 0)    (0, 0) unweighted   (0,2,0)     (2,0,0) rest    2 sqrt(2)   1
+    # 1         (0,0,0)  (1, 0)    (0.5, 0.5)          (0,0,0)     (0,0,0)         0           1
+    # 2         (0,1,0)  (0, 1)    (0.25, 0.75)        (0,1,0)     (-0.25,0.75,0)  sqrt(2)/4   0.5
+    # 3         (4,0,0)  (0, 0)    (1, 0)              not scored: the reference leaves it unweighted
+    #
+    # Vertex 2 posed with the prediction: 0.25 (-1,0,0) + 0.75 (0,1,0).
+    # L1 = (1 + 1 + 0.5) / 3. Influences pred {}, {0,1}, {0,1}; ref {0},
+    # {0}, {1}: 2 in common of 4 predicted and 3 reference.
+    # The size is the bounding-box diagonal of all four vertices (vertex 3
+    # included): |(4, 1, 0)| = sqrt(17).
+    # deform_mean = (2 sqrt(2) + 0 + sqrt(2)/4) / 3 / sqrt(17) = 0.75 sqrt(2 / 17),
+    # deform_max = 2 sqrt(2) / sqrt(17).
+    skeleton = two_root_skeleton()
+    vertices = np.array([[2.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [4.0, 0.0, 0.0]])
+    ref = np.array([[1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    pred = np.array([[0.0, 0.0], [0.2, 0.2], [0.3, 0.9], [1.0, 0.0]])
+    result = evaluate_skin(vertices, pred, ref, skeleton, quarter_turn_of_first_bone())
+    assert result["l1"] == pytest.approx(2.5 / 3.0)
+    assert result["precision"] == pytest.approx(0.5)
+    assert result["recall"] == pytest.approx(2.0 / 3.0)
+    assert result["deform_mean"] == pytest.approx(0.75 * math.sqrt(2.0 / 17.0))
+    assert result["deform_max"] == pytest.approx(2.0 * math.sqrt(2.0 / 17.0))
+    assert result["unweighted"] == 1
+
+
+def test_evaluate_skin_unweighted_vertex_on_a_chain():
+    # Bone b (head (0,0,1), child of a) turns 90 degrees about x. The
+    # reference moves vertex (0.2, 0, 1.5) with b to (0.2, -0.5, 1.0); the
+    # prediction leaves it unweighted, so it stays: 0.5 sqrt(2) apart.
+    # Size: bounding-box diagonal |(0.2, 0, 1)|. Mean over the three vertices.
+    vertices = np.array([[0.0, 0.0, 0.5], [0.0, 0.0, 1.5], [0.2, 0.0, 1.5]])
+    skeleton = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], ("a", "b"), [[0, 0, 1], [0, 0, 2]])
+    reference = Weights(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 1.0]]), ("a", "b"))
+    predicted = Weights(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), ("a", "b"))
+    poses = np.broadcast_to(np.eye(3), (1, 2, 3, 3)).copy()
+    poses[0, 1] = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]
+    scores = evaluate_skin(vertices, predicted, reference, skeleton, poses)
+    size = math.hypot(0.2, 1.0)
+    assert scores["unweighted"] == 1
+    assert scores["deform_max"] == pytest.approx(0.5 * math.sqrt(2) / size)
+    assert scores["deform_mean"] == pytest.approx(0.5 * math.sqrt(2) / size / 3)
+    assert scores["l1"] == pytest.approx(1.0 / 3)
+    assert scores["precision"] == 1.0 and scores["recall"] == pytest.approx(2.0 / 3)
 
 
 def test_evaluate_transfer_with_and_without_reference():

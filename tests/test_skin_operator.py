@@ -1,14 +1,22 @@
 """The Skin operator and the ``skin`` subcommand on a generated 2-bone cylinder."""
 
+import re
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from autorig_addon.blender.operators import skin
+from autorig_addon.blender.operators.skin import AUTORIG_OT_skin_weights, _SkinJob
+from autorig_addon.blender.progress import PROGRESS_STEPS
+from autorig_addon.core.errors import Cancelled
 from blender_fixtures import (
     BODY_HEIGHT,
     BODY_RADIUS,
     LOWER_BONE,
     UPPER_BONE,
+    RecordingWindowManager,
+    RecordingWorkspace,
     cylinder_geometry,
     group_weights,
     make_armature,
@@ -68,7 +76,9 @@ def test_armature_far_from_mesh_is_refused_and_scene_unchanged(armature_and_tube
     armature.location = (20.0, 0.0, 0.0)
     bpy.context.view_layer.update()
     before = scene_state([armature, tube])
-    with pytest.raises(RuntimeError, match="far from the mesh"):
+    with pytest.raises(RuntimeError, match=re.escape(
+            "The armature 'Armature' lies far from the mesh: move it onto the character "
+            "(or apply the object transforms) before skinning.")):
         bpy.ops.autorig.skin_weights()
     assert scene_state([armature, tube]) == before
 
@@ -81,26 +91,79 @@ def test_mesh_without_faces_is_refused_and_scene_unchanged(clean_scene):
     bpy.context.view_layer.update()
     select_only([armature, points], active=armature)
     before = scene_state([armature, points])
-    with pytest.raises(RuntimeError, match="no faces"):
+    with pytest.raises(RuntimeError, match=re.escape("'Points' has no faces: it is only vertices or edges.")):
         bpy.ops.autorig.skin_weights()
     assert scene_state([armature, points]) == before
 
 
-def test_zero_length_deform_bone_is_refused(clean_scene):
+def shrink_bone(armature, name, length=1e-5):
+    """Shrink bone ``name`` to ``length`` along +Z, disconnecting its children
+    first so their heads stay. (Blender deletes zero-length bones itself, so
+    this is below the point-like tolerance instead.)"""
+    import bpy
+
+    select_only([armature], active=armature)
+    bpy.ops.object.mode_set(mode="EDIT")
+    for bone in armature.data.edit_bones:
+        if bone.parent is not None and bone.parent.name == name:
+            bone.use_connect = False
+    bone = armature.data.edit_bones[name]
+    bone.tail = (bone.head.x, bone.head.y, bone.head.z + length)
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_zero_length_deform_bone_without_child_is_refused_by_name(clean_scene):
     import bpy
 
     armature = make_armature()
     tube = unbound_cylinder()
-    # Blender refuses zero-length bones itself, so shrink one below the tolerance instead.
-    select_only([armature], active=armature)
-    bpy.ops.object.mode_set(mode="EDIT")
-    armature.data.edit_bones[UPPER_BONE].tail = (0.0, 0.0, 1.0 + 1e-5)
-    bpy.ops.object.mode_set(mode="OBJECT")
+    shrink_bone(armature, UPPER_BONE)
     select_only([armature, tube], active=armature)
     before = scene_state([armature, tube])
-    with pytest.raises(RuntimeError, match="zero length"):
+    with pytest.raises(RuntimeError, match=f"Deform bone '{UPPER_BONE}' has zero length and no child to point at"):
         bpy.ops.autorig.skin_weights()
     assert scene_state([armature, tube]) == before
+
+
+def test_zero_length_bone_with_a_child_is_measured_to_the_child(clean_scene):
+    import bpy
+
+    from autorig_addon.blender.operators.skin import SkinSettings, compute_skin, plan_skin
+
+    armature = make_armature()
+    tube = unbound_cylinder()
+    shrink_bone(armature, LOWER_BONE)
+    tails_before = [tuple(bone.tail_local) for bone in armature.data.bones]
+    plan = plan_skin(armature, [tube], SkinSettings(resolution=32), bpy.context.evaluated_depsgraph_get())
+    assert plan.tail_decision.derived == (LOWER_BONE,)
+    assert "bone tails derived from the joints" in plan.summary
+    lower = plan.skeleton.names.index(LOWER_BONE)
+    np.testing.assert_allclose(plan.skeleton.tails[lower], [0.0, 0.0, 1.0], atol=1e-6)
+    weights = compute_skin(plan)
+    z = plan.mesh.vertices[:, 2]
+    assert weights.matrix[z < 0.3, 0].min() > 0.9 and weights.matrix[z > 1.7, 1].min() > 0.9
+    # Only the arrays changed: the armature keeps its point-like bone.
+    assert [tuple(bone.tail_local) for bone in armature.data.bones] == tails_before
+
+
+def test_skin_command_reports_derived_tails(clean_scene, tmp_path):
+    import json
+
+    import bpy
+
+    from autorig_addon.cli import main
+
+    armature = make_armature()
+    unbound_cylinder()
+    shrink_bone(armature, LOWER_BONE)
+    source = tmp_path / "rig.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source), copy=True)
+    summary = tmp_path / "summary.json"
+    assert main(["skin", str(source), "--out", str(tmp_path / "skinned.blend"), "--resolution", "32", "--quiet",
+                 "--summary", str(summary)]) == 0
+    (entry,) = json.loads(summary.read_text())["succeeded"]
+    assert entry["tails"].startswith("bone tails derived from the joints for 1 point-like bone")
+    assert f"'{LOWER_BONE}'" in entry["tails"]
 
 
 def test_skin_command_writes_groups_into_the_output(clean_scene, tmp_path):
@@ -120,3 +183,91 @@ def test_skin_command_writes_groups_into_the_output(clean_scene, tmp_path):
     np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
     z = np.array([v.co.z for v in tube.data.vertices])
     assert weights[z < 0.3, 0].min() > 0.9
+
+
+def test_write_skin_restores_every_mesh_when_a_later_write_fails(clean_scene, monkeypatch):
+    import bpy
+
+    armature = make_armature()
+    first, second = unbound_cylinder("First"), unbound_cylinder("Second")
+    plan = skin.plan_skin(armature, [first, second], skin.SkinSettings(resolution=24), bpy.context.evaluated_depsgraph_get())
+    weights = skin.compute_skin(plan)
+    before = scene_state([armature, first, second])
+    real_write = skin.write_weights
+
+    def second_write_fails(obj, *args, **kwargs):
+        if obj == second:
+            raise RuntimeError("disk full")
+        real_write(obj, *args, **kwargs)
+
+    monkeypatch.setattr(skin, "write_weights", second_write_fails)
+    with pytest.raises(RuntimeError, match="disk full"):
+        skin.write_skin(plan, weights)
+    assert scene_state([armature, first, second]) == before
+
+
+class SkinOperatorStandIn:
+    """The Skin operator's own modal, cancel and cleanup code on a plain
+    object: Blender creates operator instances only when it runs them."""
+
+    modal = AUTORIG_OT_skin_weights.modal
+    cancel = AUTORIG_OT_skin_weights.cancel
+    _end_modal = AUTORIG_OT_skin_weights._end_modal
+
+    def __init__(self, job, thread_alive=True):
+        self._job = job
+        self._timer = "timer"
+        self._thread = SimpleNamespace(is_alive=lambda: thread_alive)
+        self.reports = []
+
+    def report(self, kind, message):
+        self.reports.append((kind, message))
+
+
+def ui_context():
+    return SimpleNamespace(window_manager=RecordingWindowManager(), workspace=RecordingWorkspace())
+
+
+def test_skin_job_reports_progress_and_stops_once_cancelled(monkeypatch):
+    def fake_compute(plan, progress):
+        progress(0.5, "Voxelizing")
+        return "weights of " + plan
+
+    monkeypatch.setattr(skin, "compute_skin", fake_compute)
+    job = _SkinJob("plan")
+    job.run()
+    assert (job.fraction, job.message, job.weights, job.error) == (0.5, "Voxelizing", "weights of plan", None)
+
+    cancelled = _SkinJob("plan", cancel=True)
+    cancelled.run()
+    assert cancelled.weights is None and cancelled.fraction == 0.0
+    assert isinstance(cancelled.error, Cancelled) and str(cancelled.error) == "Skinning cancelled."
+
+
+def test_cancel_removes_timer_progress_and_status_and_stops_the_worker():
+    job = _SkinJob("plan")
+    operator, context = SkinOperatorStandIn(job), ui_context()
+    operator.cancel(context)
+    assert job.cancel  # the worker stops at its next progress report; its result is never read
+    assert context.window_manager.calls == [("remove_timer", "timer"), ("end",)]
+    assert context.workspace.texts == [None]
+    operator.cancel(context)  # a second call must not remove the timer twice
+    assert context.window_manager.calls == [("remove_timer", "timer"), ("end",)]
+    assert operator.reports == []
+
+
+def test_modal_shows_progress_then_ends_through_the_same_cleanup_on_esc():
+    job = _SkinJob("plan", fraction=0.25, message="Voxelizing")
+    operator, context = SkinOperatorStandIn(job), ui_context()
+    assert operator.modal(context, SimpleNamespace(type="ESC")) == {"RUNNING_MODAL"}
+    assert job.cancel and context.window_manager.calls == []
+    assert operator.modal(context, SimpleNamespace(type="TIMER")) == {"RUNNING_MODAL"}
+    assert context.window_manager.calls == [("update", PROGRESS_STEPS // 4)]
+    assert context.workspace.texts == ["Skin weights: Voxelizing (25%), Esc to cancel"]
+
+    job.error = Cancelled("Skinning cancelled.")  # the worker saw the request and stopped
+    operator._thread = SimpleNamespace(is_alive=lambda: False)
+    assert operator.modal(context, SimpleNamespace(type="TIMER")) == {"CANCELLED"}
+    assert context.window_manager.calls[-2:] == [("remove_timer", "timer"), ("end",)]
+    assert context.workspace.texts[-1] is None
+    assert operator.reports == [({"WARNING"}, "Skinning cancelled; nothing was changed.")]

@@ -1,24 +1,18 @@
 """Volumetric geodesic vertex-to-bone distances on shapes with known answers."""
 
+import re
+
 import numpy as np
 import pytest
-from geometry_fixtures import cylinder
-from test_voxelize import box_mesh
+from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, vertex_index
 
+from autorig_addon.core.distances.bone_distances import voxelize_covering_bones
+from autorig_addon.core.distances.interior import fill_interior
+from autorig_addon.core.distances.vertex_distances import UNREACHABLE_PENALTY
+from autorig_addon.core.distances.volumetric_geodesic import OUTSIDE_JUMP_PENALTY, volumetric_geodesic_distances
 from autorig_addon.core.errors import Cancelled, InputError
-from autorig_addon.core.types import Mesh
-from autorig_addon.core.distances.volumetric_geodesic import (
-    OUTSIDE_JUMP_PENALTY,
-    UNREACHABLE_PENALTY,
-    volumetric_geodesic_distances,
-)
 from autorig_addon.core.geometry.segments import point_segment_distances
-
-
-def vertex_index(mesh: Mesh, point) -> int:
-    index = int(np.argmin(np.linalg.norm(mesh.vertices - np.asarray(point, float), axis=1)))
-    assert np.allclose(mesh.vertices[index], point), "the fixture has no vertex there"
-    return index
+from autorig_addon.core.types import Mesh
 
 
 def u_tube() -> Mesh:
@@ -72,15 +66,10 @@ def test_bone_outside_the_mesh_gets_finite_penalised_distances():
 
 
 def test_disconnected_part_is_reached_from_the_nearest_bone():
-    body = cylinder(radius=0.2, height=1.0, segments=32, rings=21)
-    hat = box_mesh([-0.15, -0.15, 1.1], [0.15, 0.15, 1.3], 0.05)
-    mesh = Mesh.concatenate([body, hat])
-    heads = np.array([[0, 0, 0.05], [0, 0, 0.6]])
-    tails = np.array([[0, 0, 0.6], [0, 0, 0.95]])
+    mesh, hat_vertices, heads, tails = body_with_hat()
     cell = 1.3 / 88
     distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=88)
     assert np.all(np.isfinite(distances))
-    hat_vertices = np.arange(body.vertex_count, mesh.vertex_count)
     straight = point_segment_distances(mesh.vertices, heads, tails)
     assert np.all(distances[hat_vertices] > straight[hat_vertices])
     assert np.all(distances[hat_vertices, 1] < distances[hat_vertices, 0])
@@ -99,12 +88,26 @@ def test_vertex_in_no_face_gets_the_documented_fallback():
     assert distances[-1, 0] == pytest.approx(expected)
 
 
+def test_a_shared_grid_gives_the_same_distances():
+    mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
+    heads, tails = np.array([[0.5, 0.5, 0.2], [0.5, 0.5, 1.2]]), np.array([[0.5, 0.5, 0.8], [0.5, 0.5, 1.4]])
+    grid = fill_interior(voxelize_covering_bones(mesh, heads, tails, 20))
+    np.testing.assert_array_equal(
+        volumetric_geodesic_distances(mesh, heads, tails, grid=grid, resolution=5),  # resolution ignored
+        volumetric_geodesic_distances(mesh, heads, tails, resolution=20),
+    )
+
+
 def test_progress_is_reported_and_cancel_stops_the_work():
     mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
     heads, tails = np.array([[0.5, 0.5, 0.2]]), np.array([[0.5, 0.5, 0.8]])
-    fractions = []
-    volumetric_geodesic_distances(mesh, heads, tails, resolution=16, progress=lambda f, m: fractions.append(f))
-    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    reports = []
+    volumetric_geodesic_distances(mesh, heads, tails, resolution=16, progress=lambda f, m: reports.append((f, m)))
+    fractions = [fraction for fraction, _ in reports]
+    assert fractions == sorted(fractions)
+    assert reports[0] == (0.0, "Voxelising the surface")
+    assert (0.2, "Building the path graph") in reports
+    assert reports[-1] == (1.0, "Distances done")
 
     def cancel(fraction, message):
         raise Cancelled()
@@ -113,9 +116,8 @@ def test_progress_is_reported_and_cancel_stops_the_work():
         volumetric_geodesic_distances(mesh, heads, tails, resolution=16, progress=cancel)
 
 
-def test_bad_bones_are_rejected():
+@pytest.mark.parametrize("heads, tails, message", BAD_BONES)
+def test_bad_bones_are_rejected(heads, tails, message):
     mesh = box_mesh([0, 0, 0], [1, 1, 1], 0.25)
-    with pytest.raises(InputError, match="No bones"):
-        volumetric_geodesic_distances(mesh, np.zeros((0, 3)), np.zeros((0, 3)))
-    with pytest.raises(InputError, match="NaN"):
-        volumetric_geodesic_distances(mesh, [[np.nan, 0, 0]], [[0, 0, 1]])
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
+        volumetric_geodesic_distances(mesh, heads, tails)

@@ -12,32 +12,12 @@ import numpy as np
 from mathutils import Vector
 
 from ..core.errors import InputError
+from ..core.skeleton.checks import check_buildable, skeleton_extent
 from ..core.types import Skeleton
 
-#: Bones shorter than this fraction of the skeleton's size would be deleted
-#: by Blender when leaving Edit Mode; they are refused up front.
-MIN_BONE_LENGTH_FRACTION = 1e-5
-#: Blender truncates longer names, which could merge two bones.
-MAX_NAME_BYTES = 63
 #: A child whose head sits on its parent's tail (within this fraction of the
-#: size) is connected to it, so grabbing the parent's tail moves the child.
+#: skeleton's extent) is connected to it, so grabbing the parent's tail moves the child.
 CONNECT_FRACTION = 1e-6
-
-
-def check_buildable(skeleton: Skeleton) -> None:
-    """Raise :class:`InputError` if Blender cannot hold ``skeleton`` as it is."""
-    if skeleton.bone_count == 0:
-        raise InputError("The skeleton has no bones.")
-    if not (np.all(np.isfinite(skeleton.joints)) and np.all(np.isfinite(skeleton.tails))):
-        raise InputError("The skeleton has NaN or infinite joint positions.")
-    size = max(np.ptp(np.vstack([skeleton.joints, skeleton.tails]), axis=0).max(), 1e-12)
-    short = np.flatnonzero(skeleton.bone_lengths < MIN_BONE_LENGTH_FRACTION * size)
-    if len(short):
-        names = ", ".join(skeleton.names[i] for i in short[:5])
-        raise InputError(f"{len(short)} bone(s) have zero length ({names}); Blender cannot keep them.")
-    long_names = [name for name in skeleton.names if len(name.encode("utf-8")) > MAX_NAME_BYTES]
-    if long_names:
-        raise InputError(f"Bone name too long for Blender (63 bytes max): '{long_names[0]}'.")
 
 
 def build_armature(skeleton: Skeleton, name: str, context=None, collection=None):
@@ -54,6 +34,12 @@ def build_armature(skeleton: Skeleton, name: str, context=None, collection=None)
     -------
     bpy.types.Object of type 'ARMATURE', with identity transform, in Object
     Mode. The previously active object becomes active again.
+
+    Raises
+    ------
+    InputError when Blender cannot hold the skeleton
+    (:func:`~autorig_addon.core.skeleton.checks.check_buildable`) or the
+    active object is not in Object Mode; nothing is created then.
     """
     check_buildable(skeleton)
     context = context or bpy.context
@@ -88,7 +74,7 @@ def build_armature(skeleton: Skeleton, name: str, context=None, collection=None)
 
 
 def _add_edit_bones(data, skeleton: Skeleton) -> None:
-    size = max(np.ptp(skeleton.joints, axis=0).max(), 1e-12)
+    size = skeleton_extent(skeleton)
     edit_bones = []
     for j, bone_name in enumerate(skeleton.names):
         bone = data.edit_bones.new(bone_name)

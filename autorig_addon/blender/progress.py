@@ -2,7 +2,10 @@
 
 The window manager's progress (the cursor counter / status bar) and the
 workspace status text are updated; both are optional in background mode,
-where there may be no window or workspace.
+where there may be no window or workspace. :func:`blender_progress` shows
+a job that runs on the main thread; the modal Skin operator, whose job runs
+in a worker thread, shows it with :func:`progress_step` and
+:func:`progress_text` on each timer tick.
 """
 
 from __future__ import annotations
@@ -14,6 +17,16 @@ from ..core.progress import ProgressCallback
 
 #: Resolution of the window manager's progress counter (steps from 0 to 1).
 PROGRESS_STEPS = 1000
+
+
+def progress_step(fraction: float) -> int:
+    """The window manager's progress value, 0 to :data:`PROGRESS_STEPS`, of a fraction in [0, 1]."""
+    return int(round(fraction * PROGRESS_STEPS))
+
+
+def progress_text(title: str, fraction: float, message: str) -> str:
+    """Status-bar text of a running job, e.g. ``"Skin weights: Voxelizing (40%)"``."""
+    return f"{title}: {message} ({100.0 * fraction:.0f}%)"
 
 
 @contextmanager
@@ -45,9 +58,9 @@ def blender_progress(context, title: str, echo=None) -> Iterator[ProgressCallbac
 
     def update(fraction: float, message: str) -> None:
         if started:
-            window_manager.progress_update(int(round(fraction * PROGRESS_STEPS)))
+            window_manager.progress_update(progress_step(fraction))
         if workspace is not None:
-            workspace.status_text_set(f"{title}: {message} ({100.0 * fraction:.0f}%)")
+            workspace.status_text_set(progress_text(title, fraction, message))
         if echo is not None:
             echo(fraction, message)
 

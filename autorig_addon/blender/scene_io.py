@@ -8,11 +8,8 @@ from pathlib import Path
 import bpy
 
 from ..core.errors import InputError
+from ..core.io.scene_formats import LOADABLE_EXTENSIONS, SAVABLE_EXTENSIONS
 
-#: File extensions :func:`load_scene` reads.
-LOADABLE_EXTENSIONS = (".blend", ".glb", ".gltf", ".fbx", ".obj")
-#: File extensions :func:`save_scene` writes.
-SAVABLE_EXTENSIONS = (".blend", ".glb", ".gltf", ".fbx")
 #: Most object names listed in a "no such object" message.
 MAX_LISTED_NAMES = 40
 

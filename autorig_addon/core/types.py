@@ -13,6 +13,8 @@ from typing import Sequence
 import numpy as np
 
 from .errors import InputError
+from .geometry.bounding_box import bounding_box_diagonal
+from .skeleton.hierarchy import subset_parents
 
 
 @dataclass(frozen=True)
@@ -62,10 +64,9 @@ class Mesh:
 
     @property
     def bounding_box_diagonal(self) -> float:
-        """Length of the axis-aligned bounding box diagonal (0 for an empty mesh)."""
-        if not len(self.vertices):
-            return 0.0
-        return float(np.linalg.norm(self.vertices.max(0) - self.vertices.min(0)))
+        """Length of the axis-aligned bounding box diagonal (0 for an empty mesh),
+        :func:`~.geometry.bounding_box.bounding_box_diagonal` of the vertices."""
+        return bounding_box_diagonal(self.vertices)
 
     def object_slice(self, index: int) -> slice:
         return slice(int(self.object_offsets[index]), int(self.object_offsets[index + 1]))
@@ -150,23 +151,12 @@ class Skeleton:
         """(j,) float64: length of each bone."""
         return np.linalg.norm(self.tails - self.joints, axis=1)
 
-    def children(self, joint: int) -> np.ndarray:
-        return np.flatnonzero(self.parents == joint)
-
     def deform_subset(self) -> "Skeleton":
         """The skeleton restricted to deform bones, parents re-linked to the
         nearest deforming ancestor."""
         keep = np.flatnonzero(self.deform)
-        new_index = -np.ones(self.bone_count, dtype=np.int64)
-        new_index[keep] = np.arange(len(keep))
-        parents = []
-        for j in keep:
-            p = self.parents[j]
-            while p >= 0 and not self.deform[p]:
-                p = self.parents[p]
-            parents.append(new_index[p] if p >= 0 else -1)
         return Skeleton(
-            self.joints[keep], np.asarray(parents, dtype=np.int64), tuple(self.names[j] for j in keep),
+            self.joints[keep], subset_parents(self.parents, self.deform), tuple(self.names[j] for j in keep),
             self.tails[keep], np.ones(len(keep), dtype=bool),
         )
 
@@ -180,7 +170,7 @@ def _default_tails(joints: np.ndarray, parents: np.ndarray) -> np.ndarray:
     np.add.at(child_count, parents[has_parent], 1)
     with_children = child_count > 0
     tails[with_children] = child_sum[with_children] / child_count[with_children, None]
-    scale = np.linalg.norm(joints.max(0) - joints.min(0)) if len(joints) else 1.0
+    scale = bounding_box_diagonal(joints)
     for j in np.flatnonzero(~with_children):
         p = parents[j]
         direction = joints[j] - joints[p] if p >= 0 else np.array([0.0, 0.0, 1.0])

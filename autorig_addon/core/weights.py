@@ -12,6 +12,9 @@ from .errors import InputError
 
 #: Weights at or below this are treated as no influence (RigNet's threshold).
 INFLUENCE_EPSILON = 1e-4
+#: Most bones per vertex the panels and the command line offer for
+#: :func:`limit_influences` (0 there means no limit; game engines take 4 to 8).
+MAX_INFLUENCES = 16
 
 
 def normalize_rows(weights: np.ndarray) -> np.ndarray:

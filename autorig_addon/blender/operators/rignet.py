@@ -19,6 +19,8 @@ from ...core.errors import InputError
 from ...core.io.rignet_rig import read_rignet_rig, write_rignet_rig
 from .. import convert
 from ..armature_builder import build_armature
+from ..snapshot import restored_on_failure
+from ..weight_writer import write_weights
 
 
 def import_rignet_rig(context, filepath: str, mesh_obj=None):
@@ -26,31 +28,39 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
 
     Returns the armature object. ``mesh_obj`` (optional) must have the
     vertex count the file's ``skin`` lines refer to. All-or-nothing: on
-    failure nothing is left in the scene.
+    failure nothing is left in the scene and the mesh is unchanged.
     """
     vertex_count = len(mesh_obj.data.vertices) if mesh_obj is not None else None
     skeleton, weights = read_rignet_rig(filepath, vertex_count=vertex_count)
+    bind = mesh_obj is not None and weights is not None
+    if bind:
+        _check_weights_cover_mesh(weights, mesh_obj)
     name = os.path.splitext(os.path.basename(filepath))[0] or "RigNet"
     armature = build_armature(skeleton, name, context)
-    if mesh_obj is None or weights is None:
+    if not bind:
         return armature
-    skinned = np.flatnonzero(weights.matrix.any(axis=1))
-    if len(skinned) and skinned[-1] + 1 != vertex_count:
-        data = armature.data
-        bpy.data.objects.remove(armature)
-        bpy.data.armatures.remove(data)
-        raise InputError(
-            f"The file weights vertices up to {skinned[-1]}, but '{mesh_obj.name}' has {vertex_count} vertices: "
-            "it is not the mesh the rig was made for. Import without a mesh selected to get the armature alone."
-        )
     try:
-        convert.write_weights(mesh_obj, weights, armature)
+        with restored_on_failure([mesh_obj]):
+            write_weights(mesh_obj, weights, armature)
     except BaseException:
         data = armature.data
         bpy.data.objects.remove(armature)
         bpy.data.armatures.remove(data)
         raise
     return armature
+
+
+def _check_weights_cover_mesh(weights, mesh_obj) -> None:
+    """Refuse a mesh with more vertices than the file weights: the file's
+    last skinned vertex must be the mesh's last vertex (fewer vertices are
+    refused while reading the file)."""
+    skinned = np.flatnonzero(weights.matrix.any(axis=1))
+    vertex_count = len(mesh_obj.data.vertices)
+    if len(skinned) and skinned[-1] + 1 != vertex_count:
+        raise InputError(
+            f"The file weights vertices up to {skinned[-1]}, but '{mesh_obj.name}' has {vertex_count} vertices: "
+            "it is not the mesh the rig was made for. Import without a mesh selected to get the armature alone."
+        )
 
 
 def export_rignet_rig(filepath: str, armature_obj, mesh_obj=None) -> None:

@@ -24,27 +24,31 @@ from bpy.props import StringProperty
 from ...core.skinning import geometric as skinning
 from ...core.errors import Cancelled, InputError
 from ...core.progress import ProgressCallback
+from ...core.skeleton.tails import TailDecision, with_reliable_tails
 from ...core.types import Mesh, Skeleton, Weights
-from ...core.distances.voxelize import DEFAULT_RESOLUTION
+from ...core.distances.grid import DEFAULT_RESOLUTION
 from .. import convert
-from ..progress import blender_progress
+from ..progress import PROGRESS_STEPS, blender_progress, progress_step, progress_text
 from ..scene_io import find_object
+from ..snapshot import restored_on_failure
 from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
+from ..weight_writer import write_weights
 
 #: When even the deform bone point nearest the mesh's bounding box is
 #: farther than this many mesh diagonals from it, the armature was not
 #: placed on the character.
 MAX_ARMATURE_OFFSET = 0.5
-#: Deform bones shorter than this fraction of the skeleton's size count as zero-length
-#: (they have no direction to measure distances along).
-MIN_BONE_LENGTH_FRACTION = 1e-4
 #: Seconds between progress refreshes of the running modal operator.
 MODAL_TIMER_SECONDS = 0.1
+#: Prefix of the status-bar text while skinning runs.
+SKIN_PROGRESS_TITLE = "Skin weights"
 
 
 @dataclass(frozen=True)
 class SkinSettings:
-    """Options of a skinning run (see ``core.geometric_skinning.geometric_weights``).
+    """Options of a skinning run: the keyword arguments of
+    ``core.skinning.geometric.geometric_weights`` and its defaults, plus how
+    the result is written.
 
     Attributes
     ----------
@@ -68,13 +72,25 @@ class SkinSettings:
 
 @dataclass
 class SkinPlan:
-    """Checked inputs: the armature, the meshes and their arrays."""
+    """Checked inputs: the armature, the meshes and their arrays.
+
+    ``skeleton`` holds the tails distances are measured along: the
+    armature's own, or tails derived from the joints where its bones are
+    point-like (``core.skeleton.tails.with_reliable_tails``; the armature
+    itself is never changed). ``tail_decision`` says which and why.
+    """
 
     armature: object
     meshes: list
     mesh: Mesh
     skeleton: Skeleton
     settings: SkinSettings
+    tail_decision: TailDecision = TailDecision()
+
+    @property
+    def summary(self) -> str:
+        """What the report adds to "Skinned ...": the derived tails, if any."""
+        return f" ({self.tail_decision.note})" if self.tail_decision.any_derived else ""
 
 
 def _check_in_object_mode(obj) -> None:
@@ -106,18 +122,16 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph) -> Skin
     skeleton = convert.read_skeleton(armature)
     if not skeleton.deform.any():
         raise InputError(f"The armature '{armature.name}' has no deform bones: enable Deform on the bones to weight.")
-    deform = skeleton.deform_subset()
-    size = max(np.ptp(np.vstack([deform.joints, deform.tails]), axis=0).max(), 1e-12)
-    short = [name for name, length in zip(deform.names, deform.bone_lengths) if length < MIN_BONE_LENGTH_FRACTION * size]
-    if short:
-        raise InputError(f"Deform bone(s) with zero length: {', '.join(short[:5])}. Give them a length first.")
     mesh = convert.read_mesh(meshes, depsgraph)
     if not np.all(np.isfinite(mesh.vertices)):
         raise InputError("A mesh has NaN or infinite vertex positions.")
     if mesh.bounding_box_diagonal <= 0:
         raise InputError("The mesh has zero size.")
-    _check_skeleton_fits_mesh(deform, mesh, armature.name)
-    return SkinPlan(armature, list(meshes), mesh, skeleton, settings)
+    # Point-like bones (glTF imports of scaled armatures) get tails derived
+    # from the joints; a zero-length deform bone with no child is refused.
+    skeleton, tail_decision = with_reliable_tails(skeleton, mesh.bounding_box_diagonal)
+    _check_skeleton_fits_mesh(skeleton.deform_subset(), mesh, armature.name)
+    return SkinPlan(armature, list(meshes), mesh, skeleton, settings, tail_decision)
 
 
 def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> Weights:
@@ -132,16 +146,11 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
 
 def write_skin(plan: SkinPlan, weights: Weights) -> None:
     """Write each mesh's rows; on any failure every mesh is restored."""
-    snapshots = [convert.ObjectSnapshot.capture(obj) for obj in plan.meshes]
-    try:
+    with restored_on_failure(plan.meshes):
         for index, obj in enumerate(plan.meshes):
             rows = plan.mesh.object_slice(index)
-            convert.write_weights(obj, Weights(weights.matrix[rows], weights.bone_names), plan.armature,
-                                  replace_all=plan.settings.replace_all)
-    except BaseException:
-        for snapshot in snapshots:
-            snapshot.restore()
-        raise
+            write_weights(obj, Weights(weights.matrix[rows], weights.bone_names), plan.armature,
+                          replace_all=plan.settings.replace_all)
 
 
 def run_skin(armature, meshes: list, settings: SkinSettings, depsgraph, progress: ProgressCallback | None = None) -> Weights:
@@ -182,6 +191,39 @@ def _settings_from(props) -> SkinSettings:
     return SkinSettings(**values)
 
 
+@dataclass
+class _SkinJob:
+    """A skinning computation run by a worker thread for the modal operator.
+
+    The worker (:meth:`run`) writes progress and the outcome here, the
+    operator reads them on each timer tick and sets ``cancel`` to stop it.
+    The job never touches the operator or ``bpy``, so Blender may free the
+    operator (:meth:`AUTORIG_OT_skin_weights.cancel`) while it runs.
+    """
+
+    plan: SkinPlan
+    fraction: float = 0.0
+    message: str = "Starting"
+    weights: Weights | None = None
+    error: BaseException | None = None
+    cancel: bool = False
+
+    def run(self) -> None:
+        """Compute the weights into ``weights``, or the exception into
+        ``error``; once ``cancel`` is set, the next progress report raises
+        :class:`Cancelled`."""
+
+        def progress(fraction: float, message: str) -> None:
+            if self.cancel:
+                raise Cancelled("Skinning cancelled.")
+            self.fraction, self.message = fraction, message
+
+        try:
+            self.weights = compute_skin(self.plan, progress)
+        except BaseException as error:  # reported from the main thread
+            self.error = error
+
+
 class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
     """Weight the selected meshes to the selected armature from distances through the shape; Esc cancels"""
 
@@ -192,6 +234,7 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
     armature: StringProperty(name="Armature", description="Armature to bind to (empty: the selected one)")
     meshes: StringProperty(name="Meshes", description="Comma-separated meshes to skin (empty: the selected ones)")
 
+    _job = None
     _thread = None
     _timer = None
 
@@ -208,55 +251,57 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
             return self.execute(context)
         try:
             armature, meshes = resolve_skin_inputs(context, self.armature, self.meshes)
-            self._plan = plan_skin(armature, meshes, _settings_from(self), context.evaluated_depsgraph_get())
+            plan = plan_skin(armature, meshes, _settings_from(self), context.evaluated_depsgraph_get())
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self._state = {"fraction": 0.0, "message": "Starting", "result": None, "error": None, "cancel": False}
-        self._thread = threading.Thread(target=self._work, daemon=True)
+        self._job = _SkinJob(plan)
+        self._thread = threading.Thread(target=self._job.run, daemon=True)
         self._thread.start()
         window_manager = context.window_manager
         self._timer = window_manager.event_timer_add(MODAL_TIMER_SECONDS, window=context.window)
-        window_manager.progress_begin(0, 1000)
+        window_manager.progress_begin(0, PROGRESS_STEPS)
         window_manager.modal_handler_add(self)
         return {"RUNNING_MODAL"}
 
-    def _work(self) -> None:
-        state = self._state
-
-        def progress(fraction: float, message: str) -> None:
-            if state["cancel"]:
-                raise Cancelled("Skinning cancelled.")
-            state["fraction"], state["message"] = fraction, message
-
-        try:
-            state["result"] = compute_skin(self._plan, progress)
-        except BaseException as error:  # reported from the main thread
-            state["error"] = error
-
     def modal(self, context, event):
+        job = self._job
         if event.type == "ESC":
-            self._state["cancel"] = True
+            job.cancel = True
         if event.type != "TIMER":
             return {"RUNNING_MODAL"}
-        context.window_manager.progress_update(int(1000 * self._state["fraction"]))
+        context.window_manager.progress_update(progress_step(job.fraction))
         if context.workspace is not None:
-            context.workspace.status_text_set(
-                f"Skin weights: {self._state['message']} ({100 * self._state['fraction']:.0f}%), Esc to cancel")
+            text = progress_text(SKIN_PROGRESS_TITLE, job.fraction, job.message)
+            context.workspace.status_text_set(f"{text}, Esc to cancel")
         if self._thread.is_alive():
             return {"RUNNING_MODAL"}
-        self._finish_modal(context)
-        error = self._state["error"]
-        if isinstance(error, Cancelled):
+        self._end_modal(context)
+        if isinstance(job.error, Cancelled):
             self.report({"WARNING"}, "Skinning cancelled; nothing was changed.")
             return {"CANCELLED"}
-        if error is not None:
-            self.report({"ERROR"}, str(error) if isinstance(error, InputError) else f"Skinning failed: {error!r}")
+        if job.error is not None:
+            message = str(job.error) if isinstance(job.error, InputError) else f"Skinning failed: {job.error!r}"
+            self.report({"ERROR"}, message)
             return {"CANCELLED"}
-        return self._write(self._plan, self._state["result"])
+        return self._write(job.plan, job.weights)
 
-    def _finish_modal(self, context) -> None:
+    def cancel(self, context):
+        """Blender ends the running operator itself (a file is loaded, the
+        window closes): the worker stops at its next progress report, its
+        result is never written, and the timer, progress and status text go."""
+        if self._job is not None:
+            self._job.cancel = True
+        self._end_modal(context)
+
+    def _end_modal(self, context) -> None:
+        """Remove the timer, end the progress display and clear the status
+        text; the finished run (``modal``) and :meth:`cancel` both end here,
+        and a second call does nothing."""
+        if self._timer is None:
+            return
         context.window_manager.event_timer_remove(self._timer)
+        self._timer = None
         context.window_manager.progress_end()
         if context.workspace is not None:
             context.workspace.status_text_set(None)
@@ -268,14 +313,14 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.report({"INFO"}, f"Skinned {len(plan.meshes)} mesh(es) to {weights.matrix.shape[1]} deform bones of "
-                              f"'{plan.armature.name}'.")
+                              f"'{plan.armature.name}'{plan.summary}.")
         return {"FINISHED"}
 
     def execute(self, context):
         try:
             armature, meshes = resolve_skin_inputs(context, self.armature, self.meshes)
             plan = plan_skin(armature, meshes, _settings_from(self), context.evaluated_depsgraph_get())
-            with blender_progress(context, "Skin weights") as progress:
+            with blender_progress(context, SKIN_PROGRESS_TITLE) as progress:
                 weights = compute_skin(plan, progress)
         except (InputError, Cancelled) as error:
             self.report({"ERROR"}, str(error))

@@ -7,7 +7,8 @@ The work is split so nothing is written before everything is computed:
 3. :func:`write_transfer` writes all targets, restoring every one of them
    if any write fails.
 
-The command line (``autorig_addon.cli``) calls the same three functions.
+The command line (``autorig_addon.cli.transfer``) calls the same three
+functions. What each exception means: :mod:`autorig_addon.core.errors`.
 """
 
 import math
@@ -17,61 +18,49 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
-from ...core.transfer import transfer
 from ...core.errors import Cancelled, InputError
 from ...core.progress import ProgressCallback, report, sub_progress
+from ...core.transfer.combine import (
+    DEFAULT_MIX_FACTOR,
+    DEFAULT_REPLACE_MODE,
+    REPLACE_ALL,
+    check_write_mode,
+    combine_with_existing,
+    needs_existing_weights,
+)
+from ...core.transfer.options import GROUP_MEMBER_THRESHOLD, TransferOptions
+from ...core.transfer.transfer import transfer_weights
 from ...core.types import Mesh, Weights
-from ...core.weights import limit_influences, mix_weights, normalize_rows, prune_small
+from ...core.weights import normalize_rows
 from .. import convert
 from ..progress import blender_progress
-from ..ui.properties import GROUP_MEMBER_THRESHOLD, TRANSFER_OPTION_NAMES, TransferOptionProperties
-
-#: How a transfer combines with existing vertex groups (see properties.REPLACE_MODE_ITEMS).
-REPLACE_MODES = ("REPLACE", "MIX", "REPLACE_ALL")
+from ..snapshot import restored_on_failure
+from ..status_attribute import write_status_attribute
+from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties
+from ..weight_writer import write_weights
 
 
 @dataclass(frozen=True)
 class TransferSettings:
-    """Everything a transfer needs besides the objects.
+    """Everything a transfer needs besides the objects: the core's options
+    and what only the Blender layer knows (vertex groups, bones, write mode).
 
     Attributes
     ----------
-    distance_fraction, max_distance, max_normal_angle (degrees),
-    accept_flipped_normals, smoothing_iterations, smoothing_strength,
-    max_influences :
-        as in ``core.transfer.TransferOptions``.
+    options : core.transfer.options.TransferOptions
     mask_group : str, target vertex group forcing inpainting ("" = none)
     protect_group : str, target vertex group keeping its weights ("" = none)
     bones : tuple of str or None, bones to transfer (None = every deform bone)
-    replace_mode : one of :data:`REPLACE_MODES`
-    mix_factor : float in [0, 1], used by "MIX"
+    replace_mode : one of ``core.transfer.combine.REPLACE_MODES``
+    mix_factor : float in [0, 1], used by ``MIX``
     """
 
-    distance_fraction: float = transfer.DEFAULT_DISTANCE_FRACTION
-    max_distance: float | None = None
-    max_normal_angle: float = transfer.DEFAULT_MAX_NORMAL_ANGLE
-    accept_flipped_normals: bool = True
-    smoothing_iterations: int = transfer.DEFAULT_SMOOTHING_ITERATIONS
-    smoothing_strength: float = transfer.DEFAULT_SMOOTHING_STRENGTH
-    max_influences: int = 0
+    options: TransferOptions = TransferOptions()
     mask_group: str = ""
     protect_group: str = ""
     bones: tuple | None = None
-    replace_mode: str = "REPLACE"
-    mix_factor: float = 1.0
-
-    def core_options(self):
-        from ...core.transfer.transfer import TransferOptions
-
-        return TransferOptions(
-            distance_fraction=float(self.distance_fraction),
-            max_distance=None if self.max_distance is None else float(self.max_distance),
-            max_normal_angle=float(self.max_normal_angle),
-            accept_flipped_normals=bool(self.accept_flipped_normals),
-            smoothing_iterations=int(self.smoothing_iterations),
-            smoothing_strength=float(self.smoothing_strength),
-            max_influences=int(self.max_influences),
-        )
+    replace_mode: str = DEFAULT_REPLACE_MODE
+    mix_factor: float = DEFAULT_MIX_FACTOR
 
 
 @dataclass
@@ -214,13 +203,6 @@ def _transferred_bones(settings: TransferSettings, bone_names: tuple, armature) 
     return requested
 
 
-def _check_settings(settings: TransferSettings) -> None:
-    if settings.replace_mode not in REPLACE_MODES:
-        raise InputError(f"Unknown write mode '{settings.replace_mode}': use one of {', '.join(REPLACE_MODES)}.")
-    if not 0.0 <= settings.mix_factor <= 1.0:
-        raise InputError(f"The mix factor must lie between 0 and 1, got {settings.mix_factor}.")
-
-
 def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) -> TransferPlan:
     """Check the objects and read the source.
 
@@ -237,7 +219,7 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) 
     targets, objects in Edit Mode, a source with no armature or no weights
     on its deform bones, unknown bones, bad settings.
     """
-    _check_settings(settings)
+    check_write_mode(settings.replace_mode, settings.mix_factor)
     convert.require_mesh_object(source, "source")
     _check_not_in_edit_mode(source)
     for target in targets:
@@ -268,44 +250,13 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) 
     )
 
 
-def combine_with_existing(existing: np.ndarray, incoming: np.ndarray, columns: np.ndarray, settings: TransferSettings) -> np.ndarray:
-    """Final weights of a target from its existing and transferred weights.
-
-    Parameters
-    ----------
-    existing : (n, b) float64 array, the target's current weights (raw)
-    incoming : (n, b) float64 array, the transferred weights
-    columns : (k,) int array, the transferred bones' columns
-    settings : TransferSettings (replace_mode, mix_factor, max_influences)
-
-    Returns
-    -------
-    (n, b) float64 array: rows sum to one (or are zero where no bone of
-    the written set has weight).
-    """
-    if not needs_existing_weights(settings, len(columns), existing.shape[1]):
-        # The core already normalised, limited and pruned these rows.
-        return incoming
-    factor = settings.mix_factor if settings.replace_mode == "MIX" else 1.0
-    base = np.zeros_like(existing) if settings.replace_mode == "REPLACE_ALL" else existing
-    combined = mix_weights(normalize_rows(base), normalize_rows(incoming), factor, columns)
-    return prune_small(limit_influences(combined, settings.max_influences))
-
-
-def needs_existing_weights(settings: TransferSettings, transferred_count: int, bone_count: int) -> bool:
-    """Whether the target's current weights enter the result (mixing, or a
-    bone subset); a plain replace of every bone ignores them."""
-    return settings.replace_mode == "MIX" or transferred_count != bone_count
-
-
 def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallback | None) -> TargetOutcome:
-    from ...core.transfer.transfer import transfer_weights
-
     settings = plan.settings
     target_mesh = convert.read_mesh([target], depsgraph)
     inpaint_mask = convert.vertex_group_mask(target, settings.mask_group, GROUP_MEMBER_THRESHOLD)
     protected = convert.vertex_group_mask(target, settings.protect_group, GROUP_MEMBER_THRESHOLD)
-    reads_existing = protected is not None or needs_existing_weights(settings, len(plan.transferred_bones), len(plan.bone_names))
+    reads_existing = protected is not None or needs_existing_weights(
+        settings.replace_mode, len(plan.transferred_bones), len(plan.bone_names))
     if reads_existing:
         existing = convert.read_weights(target, plan.bone_names)
     else:
@@ -314,7 +265,7 @@ def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallba
         plan.source_mesh,
         plan.source_weights,
         target_mesh,
-        settings.core_options(),
+        settings.options,
         inpaint_mask=inpaint_mask,
         protected=protected,
         protected_weights=existing if protected is not None else None,
@@ -324,7 +275,8 @@ def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallba
     incoming = result.weights.matrix if same_order else result.weights.select_bones(plan.bone_names).matrix
     column_of = {name: k for k, name in enumerate(plan.bone_names)}
     columns = np.array([column_of[name] for name in plan.transferred_bones], dtype=np.int64)
-    final = combine_with_existing(existing.matrix, incoming, columns, settings)
+    final = combine_with_existing(existing.matrix, incoming, columns, settings.replace_mode, settings.mix_factor,
+                                  settings.options.max_influences)
     return TargetOutcome(target, Weights(final, plan.bone_names), np.asarray(result.status), result.summary(), dict(result.timings))
 
 
@@ -345,19 +297,14 @@ def write_transfer(plan: TransferPlan, outcomes: list[TargetOutcome]) -> None:
     All-or-nothing over all targets: if any write fails, every target is
     restored and the exception re-raised.
     """
-    snapshots = [convert.ObjectSnapshot.capture(outcome.target) for outcome in outcomes]
-    try:
+    with restored_on_failure([outcome.target for outcome in outcomes]):
         for outcome in outcomes:
-            convert.write_weights(
+            write_weights(
                 outcome.target, outcome.weights, plan.armature,
-                replace_all=plan.settings.replace_mode == "REPLACE_ALL",
+                replace_all=plan.settings.replace_mode == REPLACE_ALL,
                 keep_groups=[name for name in (plan.settings.mask_group, plan.settings.protect_group) if name],
             )
-            convert.write_status_attribute(outcome.target, outcome.status)
-    except BaseException:
-        for snapshot in snapshots:
-            snapshot.restore()
-        raise
+            write_status_attribute(outcome.target, outcome.status)
 
 
 def outcome_report(outcomes: list[TargetOutcome]) -> str:
@@ -459,7 +406,7 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             bones = selected_pose_bone_names(armature)
         else:
             bones = None
-        return TransferSettings(
+        options = TransferOptions(
             distance_fraction=self.distance_fraction,
             max_distance=self.max_distance if self.use_absolute_distance else None,
             max_normal_angle=math.degrees(self.max_normal_angle),
@@ -467,6 +414,9 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             smoothing_iterations=self.smoothing_iterations,
             smoothing_strength=self.smoothing_strength,
             max_influences=self.max_influences,
+        )
+        return TransferSettings(
+            options=options,
             mask_group=self.mask_group,
             protect_group=self.protect_group,
             bones=bones,
@@ -548,7 +498,8 @@ class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
         obj.select_set(True)
         context.view_layer.objects.active = obj
         _enter_weight_paint(obj)
-        self.report({"INFO"}, f"Paint '{name}' on '{obj.name}': painted vertices (weight 0.5 or more) will be inpainted.")
+        self.report({"INFO"}, f"Paint '{name}' on '{obj.name}': painted vertices "
+                              f"(weight {GROUP_MEMBER_THRESHOLD:g} or more) will be inpainted.")
         return {"FINISHED"}
 
 

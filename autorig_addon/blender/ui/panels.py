@@ -7,6 +7,8 @@ from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_tra
 
 #: Sidebar tab the add-on's panels live in.
 SIDEBAR_CATEGORY = "AutoRig"
+#: Object names a panel lists before counting the rest ("Shirt, Pants, Hat +2").
+MAX_LISTED_OBJECTS = 3
 
 
 class VIEW3D_PT_autorig(bpy.types.Panel):
@@ -28,6 +30,12 @@ def _target_names(context, settings) -> list[str]:
     if settings.target is not None and settings.target != source and settings.target.name not in names:
         names.append(settings.target.name)
     return names
+
+
+def _short_list(names: list[str]) -> str:
+    """``names`` joined by commas, the ones past :data:`MAX_LISTED_OBJECTS` only counted."""
+    extra = len(names) - MAX_LISTED_OBJECTS
+    return ", ".join(names[:MAX_LISTED_OBJECTS]) + (f" +{extra}" if extra > 0 else "")
 
 
 class _AutoRigSubPanel:
@@ -54,14 +62,12 @@ class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
     bl_label = "Weight Transfer"
 
     def draw_settings(self, layout, settings, context):
-
         column = layout.column(align=True)
         column.prop(settings, "source")
         column.prop(settings, "target")
         targets = _target_names(context, settings)
         if targets:
-            shown = ", ".join(targets[:3]) + (f" +{len(targets) - 3}" if len(targets) > 3 else "")
-            column.label(text=f"Targets: {shown}", icon="MESH_DATA")
+            column.label(text=f"Targets: {_short_list(targets)}", icon="MESH_DATA")
         else:
             column.label(text="Select the meshes to weight", icon="INFO")
 
@@ -109,8 +115,7 @@ class VIEW3D_PT_autorig_skin(_AutoRigSubPanel, bpy.types.Panel):
         meshes = [obj.name for obj in context.selected_objects if obj.type == "MESH"]
         column = layout.column(align=True)
         if len(armatures) == 1 and meshes:
-            shown = ", ".join(meshes[:3]) + (f" +{len(meshes) - 3}" if len(meshes) > 3 else "")
-            column.label(text=f"{shown} to {armatures[0]}", icon="ARMATURE_DATA")
+            column.label(text=f"{_short_list(meshes)} to {armatures[0]}", icon="ARMATURE_DATA")
         else:
             column.label(text="Select the meshes and one armature", icon="INFO")
 

@@ -3,6 +3,12 @@
 The transfer options live in :class:`TransferOptionProperties`, a mixin
 shared by the scene settings and the operator, so the operator exposes the
 same options to scripts and copies the scene's values when run from the UI.
+
+Defaults and bounds come from the core (``core.transfer.options``,
+``core.transfer.combine``, ``core.skinning.geometric``,
+``core.distances.grid``, ``core.weights``, ``core.geometry.smoothing``),
+where the command line takes them too; only the slider ranges (``soft_*``)
+and the absolute distance, which the panel alone offers, are declared here.
 """
 
 import math
@@ -10,28 +16,28 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from ...core.transfer.transfer import (  # the transfer defaults live with the algorithm
-    DEFAULT_DISTANCE_FRACTION,
-    DEFAULT_SMOOTHING_ITERATIONS,
-    DEFAULT_SMOOTHING_STRENGTH,
-)
-from ...core.transfer.transfer import DEFAULT_MAX_NORMAL_ANGLE as DEFAULT_MAX_NORMAL_ANGLE_DEGREES
+from ...core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
+from ...core.geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
+from ...core.skinning import geometric as skinning
+from ...core.transfer import combine
+from ...core.transfer import options as transfer_options
+from ...core.weights import MAX_INFLUENCES
 
 #: Default absolute match distance, metres, used only when "Absolute Distance" is on.
 DEFAULT_MAX_DISTANCE = 0.05
-#: Most smoothing passes the UI offers.
-MAX_SMOOTHING_ITERATIONS = 100
-#: Most influences per vertex the UI offers (0 = no limit).
-MAX_INFLUENCES_LIMIT = 16
-#: Default name of the vertex group that forces inpainting.
-DEFAULT_MASK_GROUP = "AutoRig Inpaint"
-#: Vertices with at least this weight in the mask / protect group count as members.
-GROUP_MEMBER_THRESHOLD = 0.5
+#: Slider end of the match distance fraction (larger values can be typed in).
+SOFT_MAX_DISTANCE_FRACTION = 0.25
+#: Slider end of the absolute match distance, metres.
+SOFT_MAX_DISTANCE = 1.0
+#: Slider range of the voxel resolution, cells along the longest side.
+SOFT_MIN_RESOLUTION, SOFT_MAX_RESOLUTION = 16, 256
+#: Slider end of the skinning falloff (unitless).
+SOFT_MAX_FALLOFF = 16.0
 
 REPLACE_MODE_ITEMS = (
-    ("REPLACE", "Replace", "Clear the vertex groups of the transferred bones and fill them anew; other groups stay"),
-    ("MIX", "Mix", "Blend the transferred weights into the existing ones by the mix factor"),
-    ("REPLACE_ALL", "Replace All", "Remove every vertex group of the target before writing the transferred weights"),
+    (combine.REPLACE, "Replace", "Clear the vertex groups of the transferred bones and fill them anew; other groups stay"),
+    (combine.MIX, "Mix", "Blend the transferred weights into the existing ones by the mix factor"),
+    (combine.REPLACE_ALL, "Replace All", "Remove every vertex group of the target before writing the transferred weights"),
 )
 BONE_SUBSET_ITEMS = (
     ("ALL", "All Deform Bones", "Transfer the weights of every bone with Deform enabled"),
@@ -47,10 +53,10 @@ class TransferOptionProperties:
         description="Largest distance from the target vertex to the source surface for a direct copy, "
         "as a fraction of the target's bounding-box diagonal",
         subtype="FACTOR",
-        min=0.0001,
-        max=1.0,
-        soft_max=0.25,
-        default=DEFAULT_DISTANCE_FRACTION,
+        min=transfer_options.MIN_DISTANCE_FRACTION,
+        max=transfer_options.MAX_DISTANCE_FRACTION,
+        soft_max=SOFT_MAX_DISTANCE_FRACTION,
+        default=transfer_options.DEFAULT_DISTANCE_FRACTION,
     )
     use_absolute_distance: BoolProperty(
         name="Absolute Distance",
@@ -63,28 +69,28 @@ class TransferOptionProperties:
         subtype="DISTANCE",
         unit="LENGTH",
         min=0.0,
-        soft_max=1.0,
+        soft_max=SOFT_MAX_DISTANCE,
         default=DEFAULT_MAX_DISTANCE,
     )
     max_normal_angle: FloatProperty(
         name="Normal Angle",
         description="Largest angle between the target normal and the source normal for a direct copy",
         subtype="ANGLE",
-        min=math.radians(0.1),
-        max=math.pi,
-        default=math.radians(DEFAULT_MAX_NORMAL_ANGLE_DEGREES),
+        min=math.radians(transfer_options.MIN_MAX_NORMAL_ANGLE),
+        max=math.radians(transfer_options.MAX_MAX_NORMAL_ANGLE),
+        default=math.radians(transfer_options.DEFAULT_MAX_NORMAL_ANGLE),
     )
     accept_flipped_normals: BoolProperty(
         name="Flipped Normals",
         description="Also copy where the normals point the opposite way (inner layers, inward-facing cloth)",
-        default=True,
+        default=transfer_options.DEFAULT_ACCEPT_FLIPPED_NORMALS,
     )
     smoothing_iterations: IntProperty(
         name="Smoothing",
         description="Number of smoothing passes over the inpainted vertices (0 = off)",
         min=0,
         max=MAX_SMOOTHING_ITERATIONS,
-        default=DEFAULT_SMOOTHING_ITERATIONS,
+        default=transfer_options.DEFAULT_SMOOTHING_ITERATIONS,
     )
     smoothing_strength: FloatProperty(
         name="Strength",
@@ -98,17 +104,19 @@ class TransferOptionProperties:
         name="Max Influences",
         description="Keep only this many largest bone weights per vertex (0 = no limit; 4 for most game engines)",
         min=0,
-        max=MAX_INFLUENCES_LIMIT,
-        default=0,
+        max=MAX_INFLUENCES,
+        default=transfer_options.DEFAULT_MAX_INFLUENCES,
     )
     mask_group: StringProperty(
         name="Inpaint Mask",
-        description="Vertex group on the target whose vertices (weight 0.5 or more) are always inpainted, never copied",
-        default=DEFAULT_MASK_GROUP,
+        description="Vertex group on the target whose vertices (weight "
+        f"{transfer_options.GROUP_MEMBER_THRESHOLD:g} or more) are always inpainted, never copied",
+        default=transfer_options.DEFAULT_MASK_GROUP,
     )
     protect_group: StringProperty(
         name="Protect",
-        description="Vertex group on the target whose vertices (weight 0.5 or more) keep their current weights",
+        description=f"Vertex group on the target whose vertices (weight {transfer_options.GROUP_MEMBER_THRESHOLD:g} or more) "
+        "keep their current weights",
         default="",
     )
     bone_subset: EnumProperty(
@@ -121,7 +129,7 @@ class TransferOptionProperties:
         name="Write",
         description="How the transferred weights combine with the target's existing vertex groups",
         items=REPLACE_MODE_ITEMS,
-        default="REPLACE",
+        default=combine.DEFAULT_REPLACE_MODE,
     )
     mix_factor: FloatProperty(
         name="Mix",
@@ -129,23 +137,12 @@ class TransferOptionProperties:
         subtype="FACTOR",
         min=0.0,
         max=1.0,
-        default=1.0,
+        default=combine.DEFAULT_MIX_FACTOR,
     )
 
 
 #: The option names shared by the scene settings and the operator.
 TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
-
-
-
-from ...core.skinning.geometric import (  # noqa: E402  (defaults shared with the core)
-    DEFAULT_FALLOFF,
-    DEFAULT_METHOD,
-    DEFAULT_MAX_INFLUENCES,
-)
-from ...core.skinning.geometric import DEFAULT_SMOOTHING_ITERATIONS as DEFAULT_SKIN_SMOOTHING_ITERATIONS  # noqa: E402
-from ...core.skinning.geometric import DEFAULT_SMOOTHING_STRENGTH as DEFAULT_SKIN_SMOOTHING_STRENGTH  # noqa: E402
-from ...core.distances.voxelize import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION  # noqa: E402
 
 SKIN_DISTANCE_ITEMS = (
     ("GEODESIC", "Volumetric Geodesic",
@@ -160,30 +157,31 @@ class SkinOptionProperties:
 
     skin_distance: EnumProperty(
         name="Distance", description="How the distance from a vertex to a bone is measured",
-        items=SKIN_DISTANCE_ITEMS, default=DEFAULT_METHOD.upper(),
+        items=SKIN_DISTANCE_ITEMS, default=skinning.DEFAULT_METHOD.upper(),
     )
     skin_resolution: IntProperty(
         name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "
         "(fingers, cloth) better and costs more time and memory",
-        min=MIN_RESOLUTION, max=MAX_RESOLUTION, soft_min=16, soft_max=256, default=DEFAULT_RESOLUTION,
+        min=MIN_RESOLUTION, max=MAX_RESOLUTION, soft_min=SOFT_MIN_RESOLUTION, soft_max=SOFT_MAX_RESOLUTION,
+        default=DEFAULT_RESOLUTION,
     )
     skin_falloff: FloatProperty(
         name="Falloff", description="Heat strength: how fast a bone's influence falls off away from the "
         "surface it is nearest to (unitless); higher gives sharper joints, lower softer blends",
-        min=0.1, max=64.0, soft_max=16.0, default=DEFAULT_FALLOFF,
+        min=skinning.MIN_FALLOFF, max=skinning.MAX_FALLOFF, soft_max=SOFT_MAX_FALLOFF, default=skinning.DEFAULT_FALLOFF,
     )
     skin_max_influences: IntProperty(
         name="Max Influences", description="Bones per vertex to keep (0 = no limit; 4 for most game engines)",
-        min=0, max=MAX_INFLUENCES_LIMIT, default=DEFAULT_MAX_INFLUENCES,
+        min=0, max=MAX_INFLUENCES, default=skinning.DEFAULT_MAX_INFLUENCES,
     )
     skin_smoothing_iterations: IntProperty(
         name="Smoothing", description="Extra smoothing passes of the weights over the surface "
         "(the heat diffusion is already smooth)",
-        min=0, max=MAX_SMOOTHING_ITERATIONS, default=DEFAULT_SKIN_SMOOTHING_ITERATIONS,
+        min=0, max=MAX_SMOOTHING_ITERATIONS, default=skinning.DEFAULT_SMOOTHING_ITERATIONS,
     )
     skin_smoothing_strength: FloatProperty(
         name="Smoothing Strength", description="Blend factor of one smoothing pass",
-        subtype="FACTOR", min=0.0, max=1.0, default=DEFAULT_SKIN_SMOOTHING_STRENGTH,
+        subtype="FACTOR", min=0.0, max=1.0, default=DEFAULT_SMOOTHING_STRENGTH,
     )
     skin_replace_all: BoolProperty(
         name="Replace All Groups", description="Remove every existing vertex group of the meshes first "

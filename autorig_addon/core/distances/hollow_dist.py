@@ -33,7 +33,7 @@ Implementation:
   layer multiples are removed at the end.
 * Steps have their Euclidean length (1, sqrt 2, sqrt 3 cells) rather than
   BFS hop counts, and cells are grouped into graph nodes as described in
-  :mod:`.voxelize` (never across the mesh: inside and outside hollow cells
+  :mod:`.cell_graph` (never across the mesh: inside and outside hollow cells
   are never joined directly).
 * All cells a bone touches start the search, including mesh cells, whose
   neighbours are seeded too (a bone lying in a thin part spreads to both
@@ -58,31 +58,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.segments import paired_point_segment_distances, point_segment_distances
-from ..progress import ProgressCallback, report, sub_progress
+from ..progress import ProgressCallback
 from ..types import Mesh
-from .voxelize import (
-    DEFAULT_RESOLUTION,
-    NEIGHBOUR_OFFSETS,
-    BoneGraph,
-    VoxelGrid,
-    assemble_bone_graph,
-    bone_mask,
-    covering_filled_grid,
-    dilate,
-    fill_unreached,
-    layer_cost_above,
-    merge_cells,
-    neighbour_node_pairs,
-    refine_in_sight,
-    segment_cells,
-    validate_bones,
-    vertex_distances_on_graph,
-)
+from .bone_distances import bone_distances, validate_bones
+from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, layer_cost_above, merge_cells, neighbour_node_pairs
+from .grid import DEFAULT_RESOLUTION, NEIGHBOUR_OFFSETS, VoxelGrid, segment_cells
+from .line_of_sight import refine_in_sight
 
-#: Fallback for a vertex no path reaches (cannot happen on a grid whose
-#: every cell is a node; kept so the output is finite whatever happens):
-#: this many times the straight vertex-to-bone distance.
-UNREACHABLE_PENALTY = 4.0
 #: A straight segment from a vertex to a bone counts as a hollow path when,
 #: once it has left the mesh cells around the vertex, it crosses no mesh
 #: cell until it is this many cells (along each axis) from the bone, whose
@@ -105,30 +87,16 @@ def hollow_distances(
 ) -> np.ndarray:
     """HollowDist from each vertex to each bone.
 
-    Parameters
-    ----------
-    mesh : Mesh
-    heads, tails : (b, 3) float64 arrays, bone segments in world space
-    resolution : int, cells along the longest side of the mesh's bounding
-        box (default 88), widened to cover bones near the mesh
-    grid : VoxelGrid, optional
-        A grid of this mesh already voxelised and filled, to share it
-        between distance kinds; ``resolution`` is then ignored.
-    progress : optional ProgressCallback
+    :func:`.bone_distances.bone_distances` with :func:`build_hollow_graph`
+    and :func:`refine_hollow_in_sight`; see there for the parameters (an
+    unfilled ``grid`` works for open meshes).
 
     Returns
     -------
     (n, b) float64 array of distances in scene units, all finite.
     """
-    heads, tails = validate_bones(heads, tails)
-    if grid is None:
-        grid = covering_filled_grid(mesh, heads, tails, resolution, sub_progress(progress, 0.0, 0.2))
-    report(progress, 0.2, "Building the path graph")
-    graph = build_hollow_graph(grid, heads, tails)
-    distances, layers = vertex_distances_on_graph(graph, mesh.vertices, sub_progress(progress, 0.3, 0.95))
-    distances = refine_hollow_in_sight(grid, distances, layers, mesh.vertices, heads, tails)
-    report(progress, 1.0, "Distances done")
-    return fill_unreached(distances, mesh.vertices, heads, tails, UNREACHABLE_PENALTY)
+    return bone_distances(mesh, heads, tails, build_hollow_graph, refine_hollow_in_sight,
+                          resolution=resolution, grid=grid, progress=progress)
 
 
 def build_hollow_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) -> BoneGraph:
@@ -149,8 +117,7 @@ def build_hollow_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) ->
     side = np.full(grid.shape, _OUTSIDE, dtype=np.int16)
     side[grid.inside] = _INSIDE
     side[grid.surface] = _MESH
-    fine = dilate(grid.surface | bone_mask(grid, heads, tails), FINE_MARGIN_CELLS)
-    nodes = merge_cells(grid, side, ~fine)
+    nodes = merge_cells(grid, side, ~fine_cells(grid, heads, tails, FINE_MARGIN_CELLS))
     node_side = nodes.node_class
     pairs = neighbour_node_pairs(nodes)
     sides = np.sort(node_side[pairs], axis=1)
@@ -170,14 +137,14 @@ def refine_hollow_in_sight(
 ) -> np.ndarray:
     """Straight distances for the pairs whose hollow path crossed no mesh
     layer and whose vertex sees the bone through hollow cells (see
-    :func:`.voxelize.refine_in_sight`); a path that had to cross a layer
+    :func:`.line_of_sight.refine_in_sight`); a path that had to cross a layer
     cannot be replaced by a straight segment that crosses none.
 
     Parameters
     ----------
     grid : VoxelGrid
     distances : (n, b) float64, layers : (n, b) int64, as returned by
-        :func:`.voxelize.combine_vertex_distances`
+        :func:`.vertex_distances.combine_vertex_distances`
     vertices : (n, 3) float64; heads, tails : (b, 3) float64
 
     Returns

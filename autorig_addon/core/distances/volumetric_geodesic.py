@@ -6,7 +6,7 @@ Binding, 2013). Paths run through the solid cells of a voxel grid (surface
 cells and the filled interior), so the distance from a fingertip to the
 other hand goes up the arm and across the chest, not through the air.
 
-Method (see :mod:`.voxelize` for the shared stages):
+Method (the shared stages are those of :mod:`.bone_distances`):
 
 * Voxelise the surface conservatively and fill the enclosed interior.
 * Graph: solid cells, 26-connected, each step as long as the distance
@@ -44,31 +44,16 @@ import numpy as np
 from scipy import ndimage
 
 from ..geometry.segments import paired_point_segment_distances, point_segment_distances
-from ..progress import ProgressCallback, report, sub_progress
+from ..progress import ProgressCallback
 from ..types import Mesh
-from .voxelize import (
-    DEFAULT_RESOLUTION,
-    BoneGraph,
-    VoxelGrid,
-    assemble_bone_graph,
-    bone_mask,
-    covering_filled_grid,
-    dilate,
-    fill_unreached,
-    merge_cells,
-    neighbour_node_pairs,
-    refine_in_sight,
-    segment_cells,
-    validate_bones,
-    vertex_distances_on_graph,
-)
+from .bone_distances import bone_distances, validate_bones
+from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, merge_cells, neighbour_node_pairs
+from .grid import DEFAULT_RESOLUTION, VoxelGrid, segment_cells
+from .line_of_sight import refine_in_sight
 
 #: A jump through the air from a bone to a solid part it does not cross
 #: counts this many times its straight length.
 OUTSIDE_JUMP_PENALTY = 2.0
-#: A vertex with no solid cell around it (a loose vertex in no face) gets
-#: this many times its straight distance to the bone.
-UNREACHABLE_PENALTY = 4.0
 #: Cells within this many steps of the surface or of a bone stay out of big
 #: blocks, so paths that bend around the surface or start at a bone keep
 #: full resolution.
@@ -88,31 +73,29 @@ def volumetric_geodesic_distances(
 ) -> np.ndarray:
     """Shortest distance through the solid from each vertex to each bone.
 
-    Parameters
-    ----------
-    mesh : Mesh
-    heads, tails : (b, 3) float64 arrays, bone segments in world space
-    resolution : int, cells along the longest side of the mesh's bounding
-        box (default 88), widened to cover bones near the mesh
-    grid : VoxelGrid, optional
-        A grid of this mesh already voxelised and filled (as returned by
-        :func:`fill_interior`), to share it between distance kinds;
-        ``resolution`` is then ignored.
-    progress : optional ProgressCallback
+    :func:`.bone_distances.bone_distances` with :func:`build_geodesic_graph`
+    and :func:`refine_geodesic_in_sight`; see there for the parameters.
 
     Returns
     -------
     (n, b) float64 array of distances in scene units, all finite.
     """
-    heads, tails = validate_bones(heads, tails)
-    if grid is None:
-        grid = covering_filled_grid(mesh, heads, tails, resolution, sub_progress(progress, 0.0, 0.2))
-    report(progress, 0.2, "Building the path graph")
-    graph = build_geodesic_graph(grid, heads, tails)
-    distances, _ = vertex_distances_on_graph(graph, mesh.vertices, sub_progress(progress, 0.3, 0.95))
-    distances = refine_in_sight(grid, grid.occupied, distances, mesh.vertices, heads, tails)
-    report(progress, 1.0, "Distances done")
-    return fill_unreached(distances, mesh.vertices, heads, tails, UNREACHABLE_PENALTY)
+    return bone_distances(mesh, heads, tails, build_geodesic_graph, refine_geodesic_in_sight,
+                          resolution=resolution, grid=grid, progress=progress)
+
+
+def refine_geodesic_in_sight(
+    grid: VoxelGrid, distances: np.ndarray, layers: np.ndarray, vertices: np.ndarray, heads: np.ndarray, tails: np.ndarray
+) -> np.ndarray:
+    """Straight distances where the segment from the vertex to the bone stays
+    in solid cells (:func:`.line_of_sight.refine_in_sight`); ``layers`` is
+    unused (a geodesic graph has no layer cost).
+
+    Returns
+    -------
+    (n, b) float64 array.
+    """
+    return refine_in_sight(grid, grid.occupied, distances, vertices, heads, tails)
 
 
 def build_geodesic_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) -> BoneGraph:
@@ -129,8 +112,7 @@ def build_geodesic_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) 
     """
     heads, tails = validate_bones(heads, tails)
     solid = grid.occupied
-    fine = dilate(grid.surface | bone_mask(grid, heads, tails), FINE_MARGIN_CELLS)
-    nodes = merge_cells(grid, np.where(solid, 0, -1), grid.inside & ~fine)
+    nodes = merge_cells(grid, np.where(solid, 0, -1), grid.inside & ~fine_cells(grid, heads, tails, FINE_MARGIN_CELLS))
     pairs = neighbour_node_pairs(nodes)
 
     bone, cells = segment_cells(grid, heads, tails)

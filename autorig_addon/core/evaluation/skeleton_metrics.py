@@ -19,7 +19,7 @@ counts as a zero-length bone so that it is not ignored.
 (:meth:`Skeleton.deform_subset`) and merges joints at the same place
 (:func:`merge_coincident_joints`); it reports distances in units of the
 character's size, which callers take as the bounding-box diagonal of the rest
-mesh (:func:`~.deformation.character_size`).
+mesh (:func:`~..geometry.bounding_box.character_size`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,9 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from ..geometry.bounding_box import checked_size
 from ..geometry.segments import point_segment_distances
+from ..skeleton.hierarchy import children_lists, descendant_counts, parents_first_order
 from ..types import Skeleton
 
 #: Joints closer than this share of the character size are one joint.
@@ -169,7 +171,7 @@ def chamfer_j2j(pred_joints: np.ndarray, ref_joints: np.ndarray, size: float = 1
     distance : float, in units of ``size``
     """
     pred_joints, ref_joints = _points(pred_joints, "predicted joints"), _points(ref_joints, "reference joints")
-    return _symmetric_chamfer(pred_joints, ref_joints) / _positive(size)
+    return _symmetric_chamfer(pred_joints, ref_joints) / checked_size(size)
 
 
 def chamfer_j2b(pred: Skeleton, ref: Skeleton, size: float = 1.0) -> float:
@@ -190,7 +192,7 @@ def chamfer_j2b(pred: Skeleton, ref: Skeleton, size: float = 1.0) -> float:
     """
     pred_to_ref = _joint_bone_distances(pred.joints, ref).min(axis=1).mean()
     ref_to_pred = _joint_bone_distances(ref.joints, pred).min(axis=1).mean()
-    return float(pred_to_ref + ref_to_pred) / 2.0 / _positive(size)
+    return float(pred_to_ref + ref_to_pred) / 2.0 / checked_size(size)
 
 
 def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fraction: float = BONE_SAMPLE_FRACTION) -> float:
@@ -212,7 +214,7 @@ def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fracti
     -------
     distance : float, in units of ``size``
     """
-    size = _positive(size)
+    size = checked_size(size)
     spacing = spacing_fraction * size
     pred_points = sample_bones(bone_segments(pred), spacing)
     ref_points = sample_bones(bone_segments(ref), spacing)
@@ -379,10 +381,12 @@ def constrained_tree_edit_distance(
     -------
     distance : int
     """
-    children_a, labels_a, order_a = _rooted_children(parents_a, labels_a)
-    children_b, labels_b, order_b = _rooted_children(parents_b, labels_b)
-    size_a = _subtree_sizes(children_a, order_a)
-    size_b = _subtree_sizes(children_b, order_b)
+    parents_a, labels_a = _under_virtual_root(parents_a, labels_a)
+    parents_b, labels_b = _under_virtual_root(parents_b, labels_b)
+    children_a, children_b = children_lists(parents_a), children_lists(parents_b)
+    # Children before parents, so the virtual root comes last.
+    order_a, order_b = parents_first_order(parents_a)[::-1].tolist(), parents_first_order(parents_b)[::-1].tolist()
+    size_a, size_b = descendant_counts(parents_a) + 1, descendant_counts(parents_b) + 1
     # tree[i, j]: distance between the subtrees at i and j; forest[i, j]:
     # between their forests of children.
     tree = np.zeros((len(children_a), len(children_b)), dtype=np.int64)
@@ -433,7 +437,7 @@ def evaluate_rig(
         and ``tree_edit`` (:func:`tree_edit_distance` of the hierarchies,
         unlabelled as in RigNet).
     """
-    size = _positive(size)
+    size = checked_size(size)
     pred = merge_coincident_joints(_deform_skeleton(pred, "predicted"), merge_fraction * size)
     ref = merge_coincident_joints(_deform_skeleton(ref, "reference"), merge_fraction * size)
     overlap = joint_iou_precision_recall(pred.joints, ref.joints, match_fraction * size)
@@ -467,12 +471,11 @@ def _forest_distance(i, j, kids_a, kids_b, tree, forest, size_a, size_b) -> int:
     return int(min(best, inserted + deleted + saving[rows, cols].sum()))
 
 
-def _rooted_children(parents: np.ndarray, labels: np.ndarray) -> tuple:
-    """Children lists of a forest under a virtual root, for tree distances.
+def _under_virtual_root(parents: np.ndarray, labels: np.ndarray) -> tuple:
+    """A forest joined under a virtual root, for tree distances.
 
-    Returns ``(children, labels, order)``: children per node (the virtual
-    root is the last node, index ``n``), labels with the virtual root's
-    appended, and every node in an order where children come before parents.
+    Returns ``(parents, labels)`` with one more node, the virtual root (index
+    ``n``, label :data:`_FOREST_ROOT_LABEL`), parent of the former roots.
     """
     parents = np.asarray(parents, dtype=np.int64).reshape(-1)
     labels = np.asarray(labels, dtype=np.int64).reshape(-1)
@@ -483,28 +486,10 @@ def _rooted_children(parents: np.ndarray, labels: np.ndarray) -> tuple:
         raise InputError("A parent index refers to a node that does not exist.")
     if np.any(labels == _FOREST_ROOT_LABEL):
         raise InputError(f"Label {_FOREST_ROOT_LABEL} is reserved for the virtual root.")
-    virtual_root = count
-    children = [[] for _ in range(count + 1)]
-    for node, parent in enumerate(parents.tolist()):
-        children[virtual_root if parent < 0 else parent].append(node)
-    # Depth-first preorder from the virtual root, reversed: children first.
-    preorder, stack = [], [virtual_root]
-    while stack:
-        node = stack.pop()
-        preorder.append(node)
-        stack.extend(children[node])
-    if len(preorder) != count + 1:
+    rooted = np.append(np.where(parents < 0, count, parents), -1)
+    if len(parents_first_order(rooted)) != count + 1:
         raise InputError("The parent array does not describe a forest (it has a cycle).")
-    return children, np.append(labels, _FOREST_ROOT_LABEL), preorder[::-1]
-
-
-def _subtree_sizes(children: list, order: list) -> np.ndarray:
-    """(n,) int64: number of nodes in each node's subtree, itself included."""
-    sizes = np.ones(len(children), dtype=np.int64)
-    for node in order:
-        for child in children[node]:
-            sizes[node] += sizes[child]
-    return sizes
+    return rooted, np.append(labels, _FOREST_ROOT_LABEL)
 
 
 def _deform_skeleton(skeleton: Skeleton, what: str) -> Skeleton:
@@ -531,10 +516,3 @@ def _points(points: np.ndarray, what: str) -> np.ndarray:
     if points.ndim != 2 or points.shape[1] != 3:
         raise InputError(f"The {what} must be an (n, 3) array, got shape {points.shape}.")
     return points
-
-
-def _positive(size: float) -> float:
-    size = float(size)
-    if not np.isfinite(size) or size <= 0.0:
-        raise InputError(f"The character size must be a positive length, got {size}.")
-    return size

@@ -6,6 +6,9 @@ influence each vertex, and the deformation error over random poses. For a
 weight transfer without reference weights, :func:`evaluate_transfer` reports
 how much the mesh's edges stretch under the same poses instead.
 
+:func:`evaluate_skin` is the one scoring of skin weights: the ``eval skin``
+command prints what it returns.
+
 Weights are ``(n, d)`` arrays whose columns are the deform bones of the
 skeleton in :meth:`Skeleton.deform_subset` order, or :class:`Weights`,
 which are matched to those bones by name.
@@ -15,10 +18,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .deformation import character_size, deform_weight_matrix, deformation_error, posed_edge_stretch, random_poses
 from ..errors import InputError
+from ..geometry.bounding_box import character_size
+from ..skeleton.posing import random_poses
 from ..types import Skeleton
-from ..weights import INFLUENCE_EPSILON
+from ..weights import INFLUENCE_EPSILON, normalize_rows
+from .deform_weights import deform_weight_matrix
+from .deformation import deformation_error
+from .stretch import posed_edge_stretch
 
 
 def skin_l1(pred: np.ndarray, ref: np.ndarray) -> float:
@@ -87,6 +94,15 @@ def evaluate_skin(
 ) -> dict:
     """All skin metrics of predicted weights against reference weights.
 
+    Rows of both weight sets are normalised first
+    (:func:`~..weights.normalize_rows`: negative entries clamped to zero,
+    rows scaled to sum to one, empty rows kept empty). Vertices the
+    *reference* leaves without weight (no entry above ``threshold``) are
+    left out of every metric: nothing says how they should move. A vertex
+    the *prediction* leaves without weight is counted in ``unweighted`` and
+    stays at rest in every pose, as Blender's Armature modifier leaves it,
+    so the deformation error compares it unmoved with the reference.
+
     Parameters
     ----------
     vertices : (n, 3) float64 array
@@ -97,30 +113,38 @@ def evaluate_skin(
         The reference skeleton both weight sets belong to.
     poses : (p, d, 3, 3) float64 array, optional
         Local rotations for the deformation error; default
-        :func:`~.deformation.random_poses` (10 seeded poses, 30 % of the
+        :func:`~..skeleton.posing.random_poses` (10 seeded poses, 30 % of the
         bones, angles from N(0, 25 degrees)).
     threshold : float
-        Influence threshold of :func:`influence_precision_recall`.
+        Weight above which a bone influences a vertex, in weight units
+        (RigNet: 1e-4); see :func:`influence_precision_recall`.
 
     Returns
     -------
-    dict with float values
-        ``l1`` (:func:`skin_l1`), ``precision`` and ``recall``
+    dict
+        Floats ``l1`` (:func:`skin_l1`), ``precision`` and ``recall``
         (:func:`influence_precision_recall`), ``deform_mean`` and
         ``deform_max`` (:func:`~.deformation.deformation_error`, in units of
-        the bounding-box diagonal of the rest mesh).
+        the bounding-box diagonal of the whole rest mesh), and the int
+        ``unweighted``, the number of vertices the prediction leaves without
+        weight.
     """
     vertices = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
-    pred = deform_weight_matrix(weights_pred, skeleton, len(vertices), "predicted weights")
-    ref = deform_weight_matrix(weights_ref, skeleton, len(vertices), "reference weights")
-    influence = influence_precision_recall(pred, ref, threshold)
-    deformation = deformation_error(vertices, pred, ref, skeleton, poses)
+    pred = normalize_rows(deform_weight_matrix(weights_pred, skeleton, len(vertices), "predicted weights"))
+    ref = normalize_rows(deform_weight_matrix(weights_ref, skeleton, len(vertices), "reference weights"))
+    unweighted = ~(pred > threshold).any(axis=1)
+    scored = (ref > threshold).any(axis=1)
+    influence = influence_precision_recall(pred[scored], ref[scored], threshold)
+    deformation = deformation_error(
+        vertices[scored], pred[scored], ref[scored], skeleton, poses, character_size(vertices)
+    )
     return {
-        "l1": skin_l1(pred, ref),
+        "l1": skin_l1(pred[scored], ref[scored]),
         "precision": influence["precision"],
         "recall": influence["recall"],
         "deform_mean": deformation["mean"],
         "deform_max": deformation["max"],
+        "unweighted": int(np.count_nonzero(unweighted)),
     }
 
 
@@ -139,20 +163,20 @@ def evaluate_transfer(
     vertices : (n, 3) float64 array
         Rest positions of the mesh that received the weights.
     edges : (e, 2) int64 array
-        Its edges, e.g. :func:`~.deformation.unique_edges` of its triangles.
+        Its edges, e.g. :func:`~..geometry.topology.edges` of its triangles.
     weights_pred : (n, d) float64 array or Weights
         The transferred weights (columns: deform bones of ``skeleton``).
     skeleton : Skeleton
     weights_ref : (n, d) float64 array or Weights, optional
         Reference weights of the same mesh, when they exist.
     poses : (p, d, 3, 3) float64 array, optional
-        Default :func:`~.deformation.random_poses` with its defaults.
+        Default :func:`~..skeleton.posing.random_poses` with its defaults.
 
     Returns
     -------
     dict with float values
         Always ``stretch_p99`` and ``stretch_max`` (relative edge-length
-        change, :func:`~.deformation.edge_stretch`); with a reference also
+        change, :func:`~.stretch.edge_stretch`); with a reference also
         ``deform_mean`` and ``deform_max`` (in units of the bounding-box
         diagonal of ``vertices``).
     """
@@ -163,7 +187,7 @@ def evaluate_transfer(
     stretch = posed_edge_stretch(vertices, edges, pred, skeleton, poses)
     result = {"stretch_p99": stretch["p99"], "stretch_max": stretch["max"]}
     if weights_ref is not None:
-        deformation = deformation_error(vertices, pred, weights_ref, skeleton, poses, character_size(vertices))
+        deformation = deformation_error(vertices, pred, weights_ref, skeleton, poses)
         result["deform_mean"] = deformation["mean"]
         result["deform_max"] = deformation["max"]
     return result

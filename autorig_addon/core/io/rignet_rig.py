@@ -23,7 +23,6 @@ Vertices whose weights are all zero get no ``skin`` line; pass
 
 from __future__ import annotations
 
-import heapq
 import math
 import os
 from typing import Optional, Union
@@ -31,6 +30,7 @@ from typing import Optional, Union
 import numpy as np
 
 from ..errors import InputError
+from ..skeleton.hierarchy import parents_first_order, reindexed_parents
 from ..types import Skeleton, Weights
 
 #: Keyword of each record type.
@@ -298,8 +298,9 @@ def _sorted_hierarchy(records: _Records) -> tuple[np.ndarray, np.ndarray]:
             )
         parent_of[child_index] = records.joint_index[parent]
         parent_line[child_index] = line
-    root = _root_index(records, parent_of)
-    order = _stable_parents_first_order(parent_of, root)
+    _check_single_root(records, parent_of)
+    # With one root, the joints left out of the order are those on a cycle.
+    order = parents_first_order(parent_of)
     if len(order) < joint_count:
         stuck = sorted(set(range(joint_count)) - set(order.tolist()))
         raise InputError(
@@ -307,13 +308,12 @@ def _sorted_hierarchy(records: _Records) -> tuple[np.ndarray, np.ndarray]:
             + ", ".join(repr(records.joint_names[j]) for j in stuck[:8])
             + "; these joints cannot be reached from the root. Fix their 'hier' lines."
         )
-    new_index = np.empty(joint_count, dtype=np.int64)
-    new_index[order] = np.arange(joint_count)
-    parents = np.where(parent_of[order] >= 0, new_index[np.maximum(parent_of[order], 0)], -1)
-    return order, parents
+    return order, reindexed_parents(parent_of, order)
 
 
-def _root_index(records: _Records, parent_of: np.ndarray) -> int:
+def _check_single_root(records: _Records, parent_of: np.ndarray) -> None:
+    """Raise :class:`InputError` unless exactly one joint has no parent and
+    it is the one a ``root`` line names (when there is such a line)."""
     orphans = np.flatnonzero(parent_of < 0)
     if not len(orphans):
         raise InputError(
@@ -339,25 +339,6 @@ def _root_index(records: _Records, parent_of: np.ndarray) -> int:
             f"The RigNet rig must have exactly one root; joints without a parent: {', '.join(names)}. "
             "Add the missing 'hier' lines (and one 'root' line)."
         )
-    return root
-
-
-def _stable_parents_first_order(parent_of: np.ndarray, root: int) -> np.ndarray:
-    """Topological order from ``root``; among ready joints the lowest file
-    index goes first, so files already parents-first keep their order.
-    Joints not reachable from the root (cycles) are left out."""
-    children: list[list[int]] = [[] for _ in range(len(parent_of))]
-    for child, parent in enumerate(parent_of.tolist()):
-        if parent >= 0:
-            children[parent].append(child)
-    ready = [root]
-    order = []
-    while ready:
-        joint = heapq.heappop(ready)
-        order.append(joint)
-        for child in children[joint]:
-            heapq.heappush(ready, child)
-    return np.asarray(order, dtype=np.int64)
 
 
 def _weights_from_skin(

@@ -4,8 +4,8 @@ In the spirit of Geodesic Voxel Binding (Dionne & de Lasa 2013) and of
 Blender's own bone heat (Baran & Popovic 2007), without their failure modes:
 bone heat needs every bone to be *visible* from the surface along a straight
 line inside the mesh and gives up on meshes that are not closed; here the
-distance is measured through the solid (:mod:`.volumetric_geodesic`) or
-through hollow space (:mod:`.hollow_dist`), so an arm bone does not pull the
+distance is measured through the solid (:mod:`..distances.volumetric_geodesic`)
+or through hollow space (:mod:`..distances.hollow_dist`), so an arm bone does not pull the
 torso it almost touches through the air, and every vertex of any mesh gets
 weights. Works with any armature, including one an artist built or edited:
 only the deform bones and their positions are used.
@@ -14,7 +14,7 @@ Steps:
 
 1. Distances ``d`` (n, b) from every vertex to every deform bone.
 2. Heat sources: each vertex's nearest bone ``j*`` (ties within
-   :data:`NEAREST_TIE_FRACTION` share) heats it with strength
+   :data:`.heat_diffusion.NEAREST_TIE_FRACTION` share) heats it with strength
    ``H = falloff / d_min^2``, ``d_min`` its distance to that bone in units
    of the mesh diagonal, when the vertex *sees* that bone: its distance
    through the shape equals the straight one (as bone heat's visibility
@@ -23,16 +23,16 @@ Steps:
    weak or absent and the surface takes what its neighbours have. A
    connected part that sees no bone at all is heated everywhere, so every
    part is bound.
-3. Diffusion over the surface: for every bone ``j`` solve
-   ``(-L + M H) w_j = M H p_j`` (cotangent Laplacian ``L``, lumped mass
-   ``M``, ``p_j`` the indicator of vertices whose nearest bone is ``j``) on
-   the mesh welded at its seams, with one sparse factorisation for all bones.
-   This is the steady state of heat flowing along the surface, so weights
-   blend smoothly across joints; ``falloff`` sets how sharply (higher:
-   narrower blends).
+3. Diffusion over the surface (:mod:`.heat_diffusion`): for every bone
+   ``j`` solve ``(-L + M H) w_j = M H p_j`` (cotangent Laplacian ``L``,
+   lumped mass ``M``, ``p_j`` the indicator of vertices whose nearest bone
+   is ``j``) on the mesh welded at its seams, with one sparse factorisation
+   for all bones. This is the steady state of heat flowing along the
+   surface, so weights blend smoothly across joints; ``falloff`` sets how
+   sharply (higher: narrower blends).
 4. Optional extra passes of uniform surface smoothing, then at most
    ``max_influences`` bones per vertex, rows normalised
-   (:func:`.weights.limit_influences`). Every row is non-empty: loose parts
+   (:func:`..weights.limit_influences`). Every row is non-empty: loose parts
    take their nearest bone.
 
 On the training characters of ``data_split.json`` this halves bone heat's
@@ -42,24 +42,17 @@ mean deformation error; see ``docs/skinning.md`` for the validation table.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
-from ..errors import InputError
+from ..distances.grid import DEFAULT_RESOLUTION
 from ..distances.hollow_dist import hollow_distances
-from ..geometry.mesh_ops import (
-    connected_component_labels,
-    cotangent_laplacian,
-    smooth_over_edges,
-    voronoi_mass,
-    weld_vertices,
-)
+from ..distances.volumetric_geodesic import volumetric_geodesic_distances
+from ..errors import InputError
+from ..geometry.segments import paired_point_segment_distances
+from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, smooth_over_edges
 from ..progress import ProgressCallback, report, sub_progress
 from ..types import Mesh, Skeleton, Weights
-from ..distances.volumetric_geodesic import volumetric_geodesic_distances
-from ..distances.voxelize import DEFAULT_RESOLUTION
-from ..geometry.segments import paired_point_segment_distances
 from ..weights import empty_rows, limit_influences, prune_small
+from .heat_diffusion import heat_diffusion_weights
 
 #: Distance kinds: "geodesic" (through the solid; needs closed parts for an
 #: interior, else paths follow the surface) and "hollow" (HollowDist,
@@ -72,23 +65,18 @@ DEFAULT_METHOD = "hollow"
 #: sharper transitions between bones. 4 was best on the training characters
 #: (tried 0.5 to 8).
 DEFAULT_FALLOFF = 4.0
+#: Falloffs the panel and the command line offer (unitless): from blends
+#: spanning whole limbs to a hard switch at the joint.
+MIN_FALLOFF = 0.1
+MAX_FALLOFF = 64.0
 #: Bones per vertex kept (game engines commonly take 4; 0 keeps all).
 DEFAULT_MAX_INFLUENCES = 4
 #: Extra passes of uniform surface smoothing after the diffusion (0: none;
 #: the diffusion is already smooth).
 DEFAULT_SMOOTHING_ITERATIONS = 0
-#: Share of the neighbour mean blended into a vertex per pass, in [0, 1].
-DEFAULT_SMOOTHING_STRENGTH = 0.5
-#: Bones within this relative margin of a vertex's nearest distance heat it together.
-NEAREST_TIE_FRACTION = 1e-3
-#: Distances are floored at this fraction of the mesh's bounding-box
-#: diagonal, so a vertex lying on a bone does not divide by zero.
-DISTANCE_FLOOR_FRACTION = 1e-4
 #: A vertex sees its nearest bone when its distance through the shape is at
 #: most this much (relative) longer than the straight distance.
 VISIBILITY_SLACK = 0.02
-#: Vertices closer than this fraction of the diagonal are welded for the diffusion.
-WELD_FRACTION = 1e-6
 
 
 def geometric_weights(
@@ -164,50 +152,6 @@ def sees_nearest_bone(vertices: np.ndarray, distances: np.ndarray, heads: np.nda
     nearest = distances.argmin(axis=1)
     straight = paired_point_segment_distances(vertices, heads[nearest], tails[nearest])
     return distances[rows, nearest] <= straight * (1.0 + VISIBILITY_SLACK) + 1e-12
-
-
-def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, heated: np.ndarray | None = None) -> np.ndarray:
-    """Unnormalised weights: bone heat diffused over the surface (steps 2-3
-    of the module docstring).
-
-    Parameters
-    ----------
-    mesh : Mesh with n vertices (any scale; it is normalised to unit diagonal)
-    distances : (n, b) float64 array, finite, >= 0, scene units
-    falloff : float > 0, the heat strength
-    heated : (n,) bool array, vertices their nearest bone heats (default all);
-        parts with no heated vertex are heated everywhere
-
-    Returns
-    -------
-    (n, b) float64 array, non-negative. A vertex in no triangle keeps its
-    nearest bone alone.
-    """
-    diagonal = max(mesh.bounding_box_diagonal, 1e-300)
-    welded_V, welded_F, to_welded = weld_vertices(mesh.vertices, mesh.triangles, WELD_FRACTION * diagonal)
-    count = len(welded_V)
-    relative = np.full((count, distances.shape[1]), np.inf)
-    np.minimum.at(relative, to_welded, np.asarray(distances, dtype=np.float64) / diagonal)
-    relative = np.maximum(relative, DISTANCE_FLOOR_FRACTION)
-    nearest = relative.min(axis=1)
-    sources = relative <= nearest[:, None] * (1.0 + NEAREST_TIE_FRACTION)
-    sources = sources / sources.sum(axis=1, keepdims=True)
-    unit_V = welded_V / diagonal
-    mass = voronoi_mass(unit_V, welded_F)
-    # Vertices in no triangle have no mass: give them a tiny one so they
-    # simply keep their source row instead of making the system singular.
-    mass = np.maximum(mass, 1e-12 * max(mass.max(initial=0.0), 1e-300))
-    heat = mass * float(falloff) / nearest**2
-    if heated is not None:
-        welded_heated = np.zeros(count, dtype=bool)
-        welded_heated[to_welded[np.asarray(heated, dtype=bool)]] = True
-        labels = connected_component_labels(welded_F, count)
-        part_heated = np.zeros(labels.max() + 1, dtype=bool)
-        part_heated[labels[welded_heated]] = True
-        heat = np.where(welded_heated | ~part_heated[labels], heat, 0.0)
-    system = (-cotangent_laplacian(unit_V, welded_F) + sp.diags(heat)).tocsc()
-    weights = splu(system, permc_spec="MMD_AT_PLUS_A").solve(np.asfortranarray(heat[:, None] * sources))
-    return np.maximum(weights, 0.0)[to_welded]
 
 
 def _nearest_bone_where_empty(weights: np.ndarray, distances: np.ndarray) -> np.ndarray:

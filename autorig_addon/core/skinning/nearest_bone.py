@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..geometry.segments import closest_segments
 from ..types import Mesh, Skeleton, Weights
 
+
 def nearest_bone_weights(mesh: Mesh, skeleton: Skeleton) -> Weights:
     """Weights giving each vertex wholly to its closest deform bone.
 

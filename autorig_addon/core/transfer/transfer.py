@@ -2,20 +2,21 @@
 
 Two stages:
 
-1. **Matching.** Each target vertex looks up the closest point on the source
-   surface. Its weights are copied (barycentric interpolation) only when the
-   point is closer than ``D`` and the normals agree within an angle; a second
-   pass accepts opposite normals, for inner garment layers.
-2. **Inpainting.** The remaining weights minimise
+1. **Matching** (:mod:`.matching`). Each target vertex looks up the closest
+   point on the source surface. Its weights are copied (barycentric
+   interpolation) only when the point is closer than ``D`` and the normals
+   agree within an angle; a second pass accepts opposite normals, for inner
+   garment layers.
+2. **Inpainting** (:mod:`.inpainting`). The remaining weights minimise
    ``trace(W^T Q W)`` with ``Q = -L + L M^-1 L`` (cotangent Laplacian ``L``,
    lumped Voronoi mass ``M``) with the matched rows fixed, i.e.
    ``Q_UU W_U = -Q_UI W_I``, one sparse factorisation for every bone.
 
-Beyond the paper: seams are welded before inpainting (glTF and FBX split
-vertices at UV seams, which would cut the Laplacian into patches); parts of
-the target with no match at all are seeded at their closest point so they
-move rigidly with the body; an artist mask forces inpainting and a protected
-set keeps existing weights as fixed rows.
+This module runs them: beyond the paper, seams are welded before inpainting
+(glTF and FBX split vertices at UV seams, which would cut the Laplacian into
+patches); parts of the target with no match at all are seeded at their
+closest point so they move rigidly with the body; an artist mask forces
+inpainting and a protected set keeps existing weights as fixed rows.
 """
 
 from __future__ import annotations
@@ -25,34 +26,19 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
-from ..geometry.closest_point import TriangleMeshQuery
 from ..errors import InputError
-from ..geometry.mesh_ops import (
-    connected_component_labels,
-    cotangent_laplacian,
-    non_manifold_edge_count,
-    smooth_over_edges,
-    vertex_normals,
-    voronoi_mass,
-    weld_vertices,
-)
+from ..geometry.normals import vertex_normals
+from ..geometry.smoothing import smooth_over_edges
+from ..geometry.topology import connected_component_labels, non_manifold_edge_count
+from ..geometry.weld import weld_mesh
 from ..progress import ProgressCallback, report
 from ..types import Mesh, Weights
 from ..weights import check_weights, limit_influences, normalize_rows, prune_small
+from .inpainting import inpaint_weights, inpainting_operator
+from .matching import match_closest_points
+from .options import TransferOptions
 
-#: Default match distance, as a fraction of the target's bounding-box diagonal (paper: 0.05).
-DEFAULT_DISTANCE_FRACTION = 0.05
-#: Default largest angle between target and source normals for a match, degrees (paper: 30).
-DEFAULT_MAX_NORMAL_ANGLE = 30.0
-#: Default Laplacian smoothing passes over inpainted vertices (0: none).
-DEFAULT_SMOOTHING_ITERATIONS = 0
-#: Default blend factor of one smoothing pass, in [0, 1].
-DEFAULT_SMOOTHING_STRENGTH = 0.5
-#: Vertices closer than this fraction of the target diagonal are welded for inpainting.
-WELD_FRACTION = 1e-6
 #: A target larger than this many source diagonals is taken as a unit mismatch.
 MAX_SCALE_RATIO = 5.0
 
@@ -66,40 +52,6 @@ class VertexStatus(enum.IntEnum):
     MASKED = 3
     PROTECTED = 4
     UNMATCHED_PART = 5
-
-
-@dataclass(frozen=True)
-class TransferOptions:
-    """Settings of :func:`transfer_weights`.
-
-    Attributes
-    ----------
-    distance_fraction : float
-        Match distance ``D`` as a fraction of the target bounding-box diagonal.
-    max_distance : float or None
-        Absolute ``D`` in scene units; overrides ``distance_fraction``.
-    max_normal_angle : float
-        Largest angle, in degrees, between the target normal and the source
-        normal at the closest point for a match.
-    accept_flipped_normals : bool
-        Second matching pass that accepts opposite normals (inner layers,
-        single-sided cloth modelled facing inwards).
-    smoothing_iterations : int
-        Laplacian smoothing passes over inpainted vertices after solving.
-    smoothing_strength : float
-        Blend factor in [0, 1] of each smoothing pass.
-    max_influences : int
-        Keep this many largest weights per vertex (0: no limit; 4 for most
-        game engines).
-    """
-
-    distance_fraction: float = DEFAULT_DISTANCE_FRACTION
-    max_distance: float | None = None
-    max_normal_angle: float = DEFAULT_MAX_NORMAL_ANGLE
-    accept_flipped_normals: bool = True
-    smoothing_iterations: int = DEFAULT_SMOOTHING_ITERATIONS
-    smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
-    max_influences: int = 0
 
 
 @dataclass
@@ -139,96 +91,6 @@ class TransferResult:
         if self.non_manifold_edges:
             parts.append(f"{self.non_manifold_edges} non-manifold edges")
         return ", ".join(parts)
-
-
-@dataclass(frozen=True)
-class Matches:
-    """Closest-point matching of target vertices onto the source.
-
-    Attributes
-    ----------
-    weights : (n, b) float64 array, source weights at the closest points (rows normalised)
-    distances : (n,) float64 array
-    status : (n,) int8 array, COPIED / COPIED_FLIPPED where matched, INPAINTED elsewhere
-    """
-
-    weights: np.ndarray
-    distances: np.ndarray
-    status: np.ndarray
-
-    @property
-    def matched(self) -> np.ndarray:
-        return self.status <= VertexStatus.COPIED_FLIPPED
-
-
-def match_closest_points(
-    source: Mesh, source_weights: np.ndarray, target: Mesh, target_normals: np.ndarray,
-    max_distance: float, max_normal_angle: float, accept_flipped_normals: bool,
-) -> Matches:
-    """Copy source weights onto target vertices where the closest source
-    point is near and its normal agrees (paper, section 3.1)."""
-    query = TriangleMeshQuery(source.vertices, source.triangles)
-    surface = query.closest(target.vertices)
-    weights = normalize_rows(surface.interpolate(source.triangles, source_weights))
-    source_normals = surface.interpolate(source.triangles, vertex_normals(source.vertices, source.triangles))
-    length = np.linalg.norm(source_normals, axis=1)
-    cosine = np.einsum("ij,ij->i", source_normals, target_normals) / np.maximum(length, 1e-300)
-    cosine[length == 0] = 0.0
-    cos_limit = np.cos(np.radians(max_normal_angle))
-    near = surface.distances <= max_distance
-    status = np.full(len(target.vertices), VertexStatus.INPAINTED, dtype=np.int8)
-    status[near & (cosine >= cos_limit)] = VertexStatus.COPIED
-    if accept_flipped_normals:
-        status[near & (cosine <= -cos_limit)] = VertexStatus.COPIED_FLIPPED
-    return Matches(weights, surface.distances, status)
-
-
-def inpainting_operator(V: np.ndarray, F: np.ndarray) -> sp.csr_matrix:
-    """``Q = -L + L M^-1 L`` (n, n), symmetric positive semi-definite.
-
-    The mesh is scaled to unit bounding-box diagonal first so the balance
-    between the Dirichlet term and the Laplacian energy term does not depend
-    on scene units.
-    """
-    diagonal = np.linalg.norm(V.max(0) - V.min(0)) if len(V) else 1.0
-    Vn = V / max(diagonal, 1e-300)
-    L = cotangent_laplacian(Vn, F)
-    mass = voronoi_mass(Vn, F)
-    inverse_mass = np.divide(1.0, mass, out=np.zeros_like(mass), where=mass > 0)
-    return (-L + L @ sp.diags(inverse_mass) @ L).tocsr()
-
-
-def inpaint_weights(Q: sp.spmatrix, known: np.ndarray, known_weights: np.ndarray) -> np.ndarray:
-    """Solve ``Q_UU W_U = -Q_UI W_I`` for the unknown rows.
-
-    Parameters
-    ----------
-    Q : (n, n) sparse SPD-on-unknowns matrix (see :func:`inpainting_operator`)
-    known : (n,) bool array, rows whose weights are fixed
-    known_weights : (n, b) float64 array, read on known rows only
-
-    Returns
-    -------
-    (n, b) float64 array: known rows as given, unknown rows solved (raw, not
-    clamped or normalised). Every connected part of the unknowns must touch
-    a known row, or the system is singular.
-    """
-    Q = sp.csr_matrix(Q)
-    unknown = np.flatnonzero(~known)
-    fixed = np.flatnonzero(known)
-    result = np.zeros_like(known_weights, dtype=np.float64)
-    result[fixed] = known_weights[fixed]
-    if not len(unknown):
-        return result
-    # Bones with no weight on any fixed row stay zero: skip their solves.
-    active = np.flatnonzero(np.abs(known_weights[fixed]).max(axis=0) > 0) if len(fixed) else np.zeros(0, int)
-    if not len(active):
-        return result
-    Q_uu = Q[unknown][:, unknown].tocsc()
-    rhs = -(Q[unknown][:, fixed] @ known_weights[np.ix_(fixed, active)])
-    factor = splu(Q_uu, permc_spec="MMD_AT_PLUS_A")
-    result[np.ix_(unknown, active)] = factor.solve(np.asfortranarray(rhs))
-    return result
 
 
 def transfer_weights(
@@ -272,9 +134,8 @@ def transfer_weights(
     target_diagonal = target.bounding_box_diagonal
     max_distance = options.max_distance if options.max_distance is not None else options.distance_fraction * target_diagonal
     # Everything runs on the welded mesh (seams joined) and is expanded at the end.
-    welded_V, welded_F, to_welded = weld_vertices(target.vertices, target.triangles, WELD_FRACTION * target_diagonal)
-    welded = Mesh(welded_V, welded_F, object_names=target.object_names[:1])
-    count = welded.vertex_count
+    welded, to_welded = weld_mesh(target)
+    welded_V, welded_F, count = welded.vertices, welded.triangles, welded.vertex_count
     masked = _any_copy(inpaint_mask, to_welded, count)
     protected_welded = _any_copy(protected, to_welded, count)
     timings["prepare"] = time.perf_counter() - clock
@@ -286,7 +147,8 @@ def transfer_weights(
         max_distance, options.max_normal_angle, options.accept_flipped_normals,
     )
     timings["match"] = time.perf_counter() - clock
-    if not matches.matched.any() and not protected.any():
+    matched = matches.matched
+    if not matched.any() and not protected.any():
         raise InputError(
             f"No vertex of '{target.object_names[0]}' lies within {max_distance:.4g} of the source surface "
             "with agreeing normals: are the objects far apart or at different scales? "
@@ -295,9 +157,11 @@ def transfer_weights(
     report(progress, 0.35, "Building the inpainting system")
 
     clock = time.perf_counter()
-    status = matches.status.copy()
+    status = np.full(count, VertexStatus.INPAINTED, dtype=np.int8)
+    status[matched] = VertexStatus.COPIED
+    status[matches.flipped] = VertexStatus.COPIED_FLIPPED
     status[masked] = VertexStatus.MASKED
-    known = matches.matched & ~masked
+    known = matched & ~masked
     known_weights = matches.weights.copy()
     if protected.any():
         kept = normalize_rows(protected_weights.select_bones(source_weights.bone_names).matrix)

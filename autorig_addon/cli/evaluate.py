@@ -1,12 +1,15 @@
 """``python -m autorig_addon eval {skin,rig,transfer} DATA... --method NAME``.
 
 Runs one method on rigged characters whose artist rig is the reference and
-scores it with ``core.skin_metrics`` / ``core.skeleton_metrics``. Prints a
-markdown table per category (one row per character) and a summary (mean and
-median per category and overall); ``--out`` writes the same as JSON::
+scores it with ``core.evaluation.skin_metrics.evaluate_skin``,
+``core.evaluation.skeleton_metrics.evaluate_rig`` or
+``core.evaluation.skin_metrics.evaluate_transfer``. Prints a markdown table
+per category (one row per character) and a summary (mean and median per
+category and overall, ``core.evaluation.report``); ``--out`` writes the
+same as JSON::
 
     {"task": "skin", "method": "boneheat",
-     "characters": [{"name", "category", "path", "l1", ..., "seconds", "unweighted"} |
+     "characters": [{"name", "category", "path", "l1", ..., "seconds", "unweighted", "notes"} |
                     {"name", "category", "path", "error"}],
      "summary": {"categories": {CATEGORY: {"count", "failed", "mean": {...}, "median": {...}}},
                  "overall": {...}}}
@@ -34,8 +37,9 @@ transfer
     (``stretch_p99``, ``stretch_max``). DATA files that are rigged
     characters are a self-transfer check with an exact reference: the target
     is the character's own surface pushed out along its normals by
-    :data:`SELF_TRANSFER_OFFSET_FRACTION` of its size (a skin-tight garment
-    whose right weights are the character's own), scored by stretch and
+    ``core.evaluation.self_transfer.SELF_TRANSFER_OFFSET_FRACTION`` of its
+    size (a skin-tight garment whose right weights are the character's
+    own), scored by stretch and
     ``deform_mean``/``deform_max`` against those weights.
 """
 
@@ -49,34 +53,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-import numpy as np
+from ..core.errors import InputError
+from ..core.evaluation.report import markdown_report, summarise
+from ..core.io.scene_formats import LOADABLE_EXTENSIONS
+from .batch import stdout_to_stderr
+from .exit_codes import EXIT_FAILED, EXIT_OK, UsageError
+
+NAME = "eval"
+HELP = "Score a skinning, rigging or transfer method against artist rigs"
 
 #: Task names, the first positional argument.
 TASKS = ("skin", "rig", "transfer")
 #: ``--split`` choices: subsets of ``data_split.json``.
 SPLITS = ("all", "train", "validation")
 #: Where the train/validation split lives: the repository's top folder.
-DEFAULT_SPLIT_FILE = Path(__file__).resolve().parent.parent / "data_split.json"
+DEFAULT_SPLIT_FILE = Path(__file__).resolve().parents[2] / "data_split.json"
 #: Prefix of the rig method that reads predicted rigs from a folder.
 FILE_METHOD_PREFIX = "file:"
-#: Self-transfer targets are offset along the normals by this share of the
-#: character size (bounding-box diagonal): 0.5 % of a 2 m character is 1 cm,
-#: a tight garment.
-SELF_TRANSFER_OFFSET_FRACTION = 0.005
-#: Name of the extra bone that never moves, used to keep unweighted vertices
-#: in place in the deformation error (as Blender does).
-STATIC_BONE_NAME = "autorig:static"
-#: Significant digits of metric values in the markdown tables.
-TABLE_DIGITS = 4
-
-#: Metric keys of each task, in table order.
-METRIC_KEYS = {
-    "skin": ("l1", "precision", "recall", "deform_mean", "deform_max"),
-    "rig": ("cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit"),
-    "transfer": ("stretch_p99", "stretch_max", "deform_mean", "deform_max"),
-}
-#: Extra per-character keys shown in the tables and summarised.
-EXTRA_KEYS = {"skin": ("unweighted", "seconds"), "rig": ("seconds",), "transfer": ("seconds",)}
 
 
 # --------------------------------------------------------------------------- method registries
@@ -133,8 +126,7 @@ def register_transfer_method(name: str, predict: Callable, description: str) -> 
 def _bone_heat(task: SkinInput):
     import bpy
 
-    from .blender.characters import bone_heat_weights
-    from .core.errors import InputError
+    from ..blender.characters import bone_heat_weights
 
     armature = bpy.data.objects.get(task.armature_name) if task.armature_name else None
     if armature is None:
@@ -143,35 +135,35 @@ def _bone_heat(task: SkinInput):
 
 
 def _nearest_bone(task: SkinInput):
-    from .core.skinning.nearest_bone import nearest_bone_weights
+    from ..core.skinning.nearest_bone import nearest_bone_weights
 
     return nearest_bone_weights(task.mesh, task.skeleton)
 
 
 def _geometric(task: SkinInput):
-    from .core.skinning.geometric import geometric_weights
+    from ..core.skinning.geometric import geometric_weights
 
     return geometric_weights(task.mesh, task.skeleton)
 
 
 def _closest_point_transfer(source, source_weights, target):
-    from .core.geometry.closest_point import TriangleMeshQuery
-    from .core.types import Weights
-    from .core.weights import normalize_rows
+    from ..core.geometry.closest_point import TriangleMeshQuery
+    from ..core.types import Weights
+    from ..core.weights import normalize_rows
 
     points = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
     return Weights(normalize_rows(points.interpolate(source.triangles, source_weights.matrix)), source_weights.bone_names)
 
 
 def _robust_transfer(source, source_weights, target):
-    from .core.transfer.transfer import transfer_weights
+    from ..core.transfer.transfer import transfer_weights
 
     return transfer_weights(source, source_weights, target).weights
 
 
 register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
 register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
-register_skin_method("geometric", _geometric, "core.geometric_skinning.geometric_weights with its defaults")
+register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
 register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
 register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")
 
@@ -231,9 +223,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     ------
     InputError when nothing is left to evaluate.
     """
-    from .cli import INPUT_EXTENSIONS
-    from .core.dataset import dataset
-    from .core.errors import InputError
+    from ..core import dataset
 
     split_path = Path(split_file) if split_file else DEFAULT_SPLIT_FILE
     split = None
@@ -249,7 +239,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     for text in inputs:
         root = Path(text)
         if root.is_dir():
-            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in INPUT_EXTENSIONS]
+            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]
             names = [path.relative_to(root).with_suffix("").as_posix() for path in files]
         elif root.is_file():
             files, names = [root], [root.stem]
@@ -281,72 +271,6 @@ def _split_entry(path: Path, split) -> Optional[str]:
     return max(matches, key=len) if matches else None
 
 
-# --------------------------------------------------------------------------- scoring
-
-
-def skin_scores(vertices: np.ndarray, predicted, reference, skeleton, poses: Optional[np.ndarray] = None) -> dict:
-    """Skin metrics of ``predicted`` against ``reference`` weights.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float64 array, rest positions
-    predicted, reference : Weights (n, *), matched to the deform bones by name
-    skeleton : Skeleton
-    poses : (p, d, 3, 3) float64 array, optional; default
-        ``deformation.random_poses(skeleton)``
-
-    Returns
-    -------
-    dict with ``l1``, ``precision``, ``recall``, ``deform_mean``,
-    ``deform_max`` (see the module docstring) and ``unweighted`` (int).
-    Predicted rows are normalised; vertices without reference weight are
-    left out of every metric.
-    """
-    from .core.evaluation.deformation import character_size, deformation_error, random_poses
-    from .core.evaluation.skin_metrics import influence_precision_recall, skin_l1
-    from .core.types import Skeleton
-    from .core.weights import INFLUENCE_EPSILON, normalize_rows
-
-    deform = skeleton.deform_subset()
-    pred = normalize_rows(predicted.select_bones(deform.names).matrix)
-    ref = normalize_rows(reference.select_bones(deform.names).matrix)
-    unweighted = ~(pred > INFLUENCE_EPSILON).any(axis=1)
-    scored = (ref > INFLUENCE_EPSILON).any(axis=1)
-    if poses is None:
-        poses = random_poses(skeleton)
-    influence = influence_precision_recall(pred[scored], ref[scored])
-    # A root bone that never turns holds the vertices left unweighted, so
-    # they stay at rest under every pose, as Blender leaves them.
-    with_static = Skeleton(
-        np.vstack([deform.joints, vertices.mean(axis=0)]), np.append(deform.parents, -1),
-        deform.names + (STATIC_BONE_NAME,), np.vstack([deform.tails, vertices.mean(axis=0) + [0.0, 0.0, 1.0]]),
-    )
-    static_column = unweighted.astype(np.float64)[:, None]
-    identity = np.broadcast_to(np.eye(3), (len(poses), 1, 3, 3))
-    deformation = deformation_error(
-        vertices[scored], np.hstack([pred, static_column])[scored], np.hstack([ref, np.zeros_like(static_column)])[scored],
-        with_static, np.concatenate([poses, identity], axis=1), character_size(vertices),
-    )
-    return {
-        "l1": skin_l1(pred[scored], ref[scored]),
-        "precision": influence["precision"],
-        "recall": influence["recall"],
-        "deform_mean": deformation["mean"],
-        "deform_max": deformation["max"],
-        "unweighted": int(np.count_nonzero(unweighted)),
-    }
-
-
-def self_transfer_target(mesh, size: float):
-    """The character's surface pushed out along its vertex normals by
-    :data:`SELF_TRANSFER_OFFSET_FRACTION` of ``size`` (same vertex order)."""
-    from .core.geometry.mesh_ops import vertex_normals
-    from .core.types import Mesh
-
-    offset = SELF_TRANSFER_OFFSET_FRACTION * size * vertex_normals(mesh.vertices, mesh.triangles)
-    return Mesh(mesh.vertices + offset, mesh.triangles, mesh.triangle_polygons, mesh.object_offsets, mesh.object_names)
-
-
 # --------------------------------------------------------------------------- evaluation
 
 
@@ -358,7 +282,6 @@ def _predict_timed(predict: Callable, *args) -> tuple:
 
 def _rig_predictor(method: str) -> Callable:
     """``predict(mesh, item) -> Skeleton`` for a rig method name."""
-    from .core.errors import InputError
 
     if method.startswith(FILE_METHOD_PREFIX):
         folder = Path(method[len(FILE_METHOD_PREFIX):])
@@ -366,7 +289,7 @@ def _rig_predictor(method: str) -> Callable:
             raise InputError(f"The folder of predicted rigs '{folder}' does not exist.")
 
         def read_predicted(mesh, item: DataItem):
-            from .core.io.rignet_rig import read_rignet_rig
+            from ..core.io.rignet_rig import read_rignet_rig
 
             candidates = [folder / f"{item.name}.txt", folder / f"{item.name}_rig.txt",
                           folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
@@ -384,7 +307,6 @@ def _rig_predictor(method: str) -> Callable:
 
 def check_method(task: str, method: str) -> None:
     """Raise InputError when ``method`` cannot run for ``task``."""
-    from .core.errors import InputError
 
     if task == "skin":
         if method != REFERENCE_METHOD and method not in SKIN_METHODS:
@@ -397,7 +319,8 @@ def check_method(task: str, method: str) -> None:
 
 def evaluate_skin_item(item: DataItem, method: str) -> dict:
     """Load one character, run a skin method on it and score it."""
-    from .blender.characters import load_character
+    from ..blender.characters import load_character
+    from ..core.evaluation.skin_metrics import evaluate_skin
 
     character = load_character(item.path, item.name, item.category)
     if method == REFERENCE_METHOD:
@@ -405,19 +328,20 @@ def evaluate_skin_item(item: DataItem, method: str) -> dict:
     else:
         task = SkinInput(character.mesh, character.skeleton, character.armature_name)
         predicted, seconds = _predict_timed(SKIN_METHODS[method].predict, task)
-    scores = skin_scores(character.mesh.vertices, predicted, character.weights, character.skeleton)
+    scores = evaluate_skin(character.mesh.vertices, predicted, character.weights, character.skeleton)
     return {**scores, "seconds": seconds, "vertices": character.mesh.vertex_count,
-            "reference_unweighted": character.unweighted_count}
+            "reference_unweighted": character.unweighted_count, "notes": list(character.notes)}
 
 
 def evaluate_rig_item(item: DataItem, method: str) -> dict:
     """Load one character, predict its rig from the mesh alone and score it."""
-    from .blender.characters import load_character
-    from .core.evaluation.skeleton_metrics import evaluate_rig
+    from ..blender.characters import load_character
+    from ..core.evaluation.skeleton_metrics import evaluate_rig
 
     character = load_character(item.path, item.name, item.category)
     predicted, seconds = _predict_timed(_rig_predictor(method), character.mesh, item)
-    return {**evaluate_rig(predicted, character.skeleton, character.size), "seconds": seconds}
+    return {**evaluate_rig(predicted, character.skeleton, character.size), "seconds": seconds,
+            "notes": list(character.notes)}
 
 
 @dataclass
@@ -432,7 +356,7 @@ class _TransferSource:
 def load_transfer_source(path: Optional[str]) -> Optional[_TransferSource]:
     if not path:
         return None
-    from .blender.characters import load_character
+    from ..blender.characters import load_character
 
     body = load_character(path)
     return _TransferSource(body.mesh, body.weights, body.skeleton)
@@ -442,8 +366,7 @@ def _garment_mesh():
     """Every mesh with faces in the loaded scene, as one Mesh."""
     import bpy
 
-    from .blender import convert
-    from .core.errors import InputError
+    from ..blender import convert
 
     objects = [obj for obj in bpy.context.scene.objects if obj.type == "MESH" and len(obj.data.polygons)]
     if not objects:
@@ -454,10 +377,10 @@ def _garment_mesh():
 def evaluate_transfer_item(item: DataItem, method: str, source: Optional[_TransferSource]) -> dict:
     """Transfer onto one DATA file: a self-transfer check for a rigged
     character, a garment transfer from ``source`` otherwise."""
-    from .blender import characters, scene_io
-    from .core.evaluation.deformation import unique_edges
-    from .core.errors import InputError
-    from .core.evaluation.skin_metrics import evaluate_transfer
+    from ..blender import characters, scene_io
+    from ..core.evaluation.self_transfer import self_transfer_target
+    from ..core.evaluation.skin_metrics import evaluate_transfer
+    from ..core.geometry.topology import edges
 
     scene_io.load_scene(item.path)
     try:
@@ -471,14 +394,14 @@ def evaluate_transfer_item(item: DataItem, method: str, source: Optional[_Transf
         target = self_transfer_target(character.mesh, character.size)
         predicted, seconds = _predict_timed(predict, character.mesh, character.weights, target)
         scores = evaluate_transfer(
-            target.vertices, unique_edges(target.triangles), predicted, character.skeleton, character.weights,
+            target.vertices, edges(target.triangles), predicted, character.skeleton, character.weights,
         )
         return {**scores, "seconds": seconds, "kind": "self", "vertices": target.vertex_count}
     if source is None:
         raise InputError(f"'{item.name}' is not rigged, so it is a garment: give the body with --source.")
     target = _garment_mesh()
     predicted, seconds = _predict_timed(predict, source.mesh, source.weights, target)
-    scores = evaluate_transfer(target.vertices, unique_edges(target.triangles), predicted, source.skeleton)
+    scores = evaluate_transfer(target.vertices, edges(target.triangles), predicted, source.skeleton)
     return {**scores, "seconds": seconds, "kind": "garment", "vertices": target.vertex_count}
 
 
@@ -490,8 +413,6 @@ def evaluate(task: str, method: str, items: list[DataItem], source_path: Optiona
     dict: ``task``, ``method``, ``characters`` (one dict per item) and
     ``summary`` (:func:`summarise`).
     """
-    from .cli import stdout_to_stderr
-
     check_method(task, method)
     with stdout_to_stderr():
         source = load_transfer_source(source_path) if task == "transfer" else None
@@ -516,110 +437,10 @@ def evaluate(task: str, method: str, items: list[DataItem], source_path: Optiona
     return {"task": task, "method": method, "characters": characters, "summary": summarise(task, characters)}
 
 
-def summarise(task: str, characters: list[dict]) -> dict:
-    """Mean and median of every metric per category and over all characters.
-
-    Returns
-    -------
-    dict: ``categories`` maps each category to ``{"count", "failed",
-    "mean": {key: value}, "median": {key: value}}``; ``overall`` is the same
-    over every character. Failed characters only count in ``failed``; a
-    metric no character has (e.g. ``deform_mean`` of garments) is left out.
-    """
-    keys = METRIC_KEYS[task] + EXTRA_KEYS[task]
-    groups: dict[str, list[dict]] = {}
-    for entry in characters:
-        groups.setdefault(entry["category"], []).append(entry)
-
-    def statistics(entries: list[dict]) -> dict:
-        done = [entry for entry in entries if "error" not in entry]
-        result = {"count": len(done), "failed": len(entries) - len(done), "mean": {}, "median": {}}
-        for key in keys:
-            values = [float(entry[key]) for entry in done if key in entry]
-            if values:
-                result["mean"][key] = float(np.mean(values))
-                result["median"][key] = float(np.median(values))
-        return result
-
-    return {
-        "categories": {category: statistics(entries) for category, entries in sorted(groups.items())},
-        "overall": statistics(characters),
-    }
-
-
 # --------------------------------------------------------------------------- output
 
 
-def _cell(value) -> str:
-    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
-        return str(int(value))
-    if isinstance(value, float):
-        return f"{value:.{TABLE_DIGITS}g}"
-    return str(value)
-
-
-def markdown_report(report: dict, baseline: Optional[dict] = None) -> str:
-    """The report as markdown: one table per category, then the summary.
-
-    With a ``baseline`` report (same task, e.g. ``boneheat``), each metric
-    cell reads ``ours / baseline`` where the baseline scored that character,
-    and the summary compares the means.
-    """
-    task = report["task"]
-    keys = METRIC_KEYS[task] + EXTRA_KEYS[task]
-    base_entries = _matching_entries(report, baseline) if baseline else {}
-    title = f"## {task}: {report['method']}" + (f" (/ {baseline['method']})" if baseline else "")
-    lines = [title, ""]
-    by_category: dict[str, list[dict]] = {}
-    for entry in report["characters"]:
-        by_category.setdefault(entry["category"], []).append(entry)
-    for category, entries in sorted(by_category.items()):
-        shown = [key for key in keys if any(key in entry for entry in entries)] or list(METRIC_KEYS[task])
-        lines += [f"### {category}", "", "| character | " + " | ".join(shown) + " |", "|---" * (len(shown) + 1) + "|"]
-        for entry in entries:
-            if "error" in entry:
-                message = entry["error"].replace("|", "/").replace("\n", " ")
-                lines.append(f"| {entry['name']} | failed: {message} |" + " |" * (len(shown) - 1))
-                continue
-            base = base_entries.get(entry["path"], {})
-            cells = [_cell(entry.get(key, "")) + (f" / {_cell(base[key])}" if key in base else "") for key in shown]
-            lines.append(f"| {entry['name']} | " + " | ".join(cells) + " |")
-        lines.append("")
-    summary = report["summary"]
-    # The baseline is summarised over the characters both reports scored, so the means compare like with like.
-    base_summary = summarise(task, list(base_entries.values())) if baseline else {}
-    base_rows = dict(base_summary.get("categories", {}), **({"**overall**": base_summary["overall"]} if base_summary else {}))
-    shown = [key for key in keys if key in summary["overall"]["mean"]]
-    heading = "### Summary (mean / median)" if not baseline else f"### Summary (mean: {report['method']} / {baseline['method']})"
-    lines += [heading, "", "| category | n | failed | " + " | ".join(shown) + " |", "|---" * (len(shown) + 3) + "|"]
-    rows = list(summary["categories"].items()) + [("**overall**", summary["overall"])]
-    for category, statistics in rows:
-        other = base_rows.get(category, {}).get("mean", {}) if baseline else None
-        cells = []
-        for key in shown:
-            if key not in statistics["mean"]:
-                cells.append("")
-            elif baseline:
-                cells.append(_cell(statistics["mean"][key]) + (f" / {_cell(other[key])}" if key in other else ""))
-            else:
-                cells.append(f"{_cell(statistics['mean'][key])} / {_cell(statistics['median'][key])}")
-        lines.append(f"| {category} | {statistics['count']} | {statistics['failed']} | " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-def _matching_entries(report: dict, baseline: dict) -> dict:
-    """Baseline entries scored for the same files as ``report``'s, by path."""
-    scored = {str(Path(entry["path"]).resolve()): entry for entry in baseline["characters"] if "error" not in entry}
-    matched = {}
-    for entry in report["characters"]:
-        other = scored.get(str(Path(entry["path"]).resolve()))
-        if other is not None:
-            matched[entry["path"]] = {**other, "category": entry["category"]}
-    return matched
-
-
 def _read_baseline(path: str, task: str) -> dict:
-    from .core.errors import InputError
 
     try:
         baseline = json.loads(Path(path).read_text(encoding="utf-8"))
@@ -632,12 +453,20 @@ def _read_baseline(path: str, task: str) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     """The ``eval`` subcommand. Exit code 0 when every character was scored,
-    1 when some failed (they are in the report with their error)."""
-    from .cli import EXIT_FAILED, EXIT_OK
+    1 when some failed (they are in the report with their error).
 
-    items = collect_data(args.data, args.split, args.split_file)
+    Raises
+    ------
+    UsageError (exit code 2) when the arguments name no file to evaluate,
+    an unknown method or an unreadable baseline: nothing was run.
+    """
+    try:
+        check_method(args.task, args.method)
+        items = collect_data(args.data, args.split, args.split_file)
+        baseline = _read_baseline(args.baseline, args.task) if args.baseline else None
+    except InputError as error:
+        raise UsageError(str(error)) from None
     log = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
-    baseline = _read_baseline(args.baseline, args.task) if args.baseline else None
     report = evaluate(args.task, args.method, items, args.source, log)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,93 @@
+"""``python -m autorig_addon skin``: weight meshes to an armature.
+
+Defaults and bounds are the core's (``core.skinning.geometric``,
+``core.distances.grid``), the ones the Blender panel offers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+from ..core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
+from ..core.errors import InputError
+from ..core.skinning import geometric as skinning
+from .arguments import add_weight_arguments, bounded
+from .batch import add_batch_arguments, run_batch
+
+NAME = "skin"
+HELP = "Weight meshes to an armature from voxel distances through the shape"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    add_batch_arguments(parser)
+    parser.add_argument("--armature", default="", help="Armature to bind to (default: the only armature in the file)")
+    parser.add_argument("--mesh", action="append", default=[], metavar="OBJ",
+                        help="Mesh to skin (repeat, or comma-separate; default: every mesh except bone shapes)")
+    parser.add_argument("--distance", choices=skinning.METHODS, default=skinning.DEFAULT_METHOD,
+                        help=f"hollow: HollowDist through empty space, reaches bones outside the body and "
+                             "loose parts (HeterSkinNet); geodesic: through the inside of the mesh (RigNet) "
+                             f"(default {skinning.DEFAULT_METHOD})")
+    parser.add_argument("--resolution", type=bounded(int, MIN_RESOLUTION, MAX_RESOLUTION), default=DEFAULT_RESOLUTION,
+                        help=f"Voxels along the longest side, {MIN_RESOLUTION} to {MAX_RESOLUTION} "
+                             f"(default {DEFAULT_RESOLUTION})")
+    parser.add_argument("--falloff", type=bounded(float, skinning.MIN_FALLOFF, skinning.MAX_FALLOFF),
+                        default=skinning.DEFAULT_FALLOFF,
+                        help="Heat strength: higher gives sharper blends between bones, "
+                             f"{skinning.MIN_FALLOFF:g} to {skinning.MAX_FALLOFF:g} (default {skinning.DEFAULT_FALLOFF:g})")
+    add_weight_arguments(parser, skinning.DEFAULT_MAX_INFLUENCES, skinning.DEFAULT_SMOOTHING_ITERATIONS,
+                         "Extra surface smoothing passes")
+    parser.add_argument("--replace-all", action="store_true",
+                        help="Remove every existing vertex group first (default: only the deform bones' groups)")
+
+
+def skin_objects(armature_name: str, mesh_names: list[str]):
+    """The armature and meshes a skin run binds, from names or the file's content."""
+    import bpy
+
+    from ..blender import scene_io
+    from ..blender.operators.transfer import split_names
+
+    if armature_name:
+        armature = scene_io.find_object(armature_name, "ARMATURE")
+    else:
+        armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+        if len(armatures) != 1:
+            found = ", ".join(obj.name for obj in armatures) or "none"
+            raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
+        armature = armatures[0]
+    names = [name for text in mesh_names for name in split_names(text)]
+    if names:
+        return armature, [scene_io.find_object(name, "MESH") for name in names]
+    shapes = {bone.custom_shape for obj in bpy.data.objects if obj.type == "ARMATURE" for bone in obj.pose.bones}
+    meshes = [obj for obj in bpy.data.objects if obj.type == "MESH" and obj not in shapes]
+    if not meshes:
+        raise InputError("The file holds no mesh to skin.")
+    return armature, meshes
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..blender.operators.skin import SkinSettings, compute_skin, plan_skin, write_skin
+
+    # The options' destinations are named after the SkinSettings fields.
+    settings = SkinSettings(**{field.name: getattr(args, field.name) for field in dataclasses.fields(SkinSettings)})
+
+    def process(input_path, output_path, progress):
+        import bpy
+
+        from ..blender import scene_io
+
+        scene_io.load_scene(input_path)
+        armature, meshes = skin_objects(args.armature, args.mesh)
+        plan = plan_skin(armature, meshes, settings, bpy.context.evaluated_depsgraph_get())
+        weights = compute_skin(plan, progress)
+        write_skin(plan, weights)
+        progress(1.0, "Saving")
+        scene_io.save_scene(output_path)
+        details = {"armature": armature.name, "meshes": [obj.name for obj in meshes],
+                   "bones": len(weights.bone_names), "vertices": int(weights.matrix.shape[0])}
+        if plan.tail_decision.any_derived:
+            details["tails"] = plan.tail_decision.note
+        return details
+
+    return run_batch(args.inputs, args.out, args.format, process, args.summary, args.quiet)

@@ -1,0 +1,73 @@
+"""Options of the robust weight transfer: defaults and the bounds the panel
+and the command line offer, declared once.
+
+:class:`TransferOptions` carries the algorithm's settings; the Blender
+properties, the operator and ``python -m autorig_addon transfer`` take their
+defaults, limits and units from the constants here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
+from ..weights import MAX_INFLUENCES
+
+#: Default match distance ``D``, as a fraction of the target's bounding-box diagonal (paper: 0.05).
+DEFAULT_DISTANCE_FRACTION = 0.05
+#: Match distances offered, fractions of the target's diagonal: from a
+#: skin-tight layer to the whole target size.
+MIN_DISTANCE_FRACTION = 0.0001
+MAX_DISTANCE_FRACTION = 1.0
+#: Default largest angle between target and source normals for a match, degrees (paper: 30).
+DEFAULT_MAX_NORMAL_ANGLE = 30.0
+#: Normal angles offered, degrees: 180 accepts any direction.
+MIN_MAX_NORMAL_ANGLE = 0.1
+MAX_MAX_NORMAL_ANGLE = 180.0
+#: By default a second matching pass accepts opposite normals (inner layers).
+DEFAULT_ACCEPT_FLIPPED_NORMALS = True
+#: Default Laplacian smoothing passes over inpainted vertices (0: none; the
+#: inpainting is already smooth).
+DEFAULT_SMOOTHING_ITERATIONS = 0
+#: Default bones kept per vertex (0: no limit).
+DEFAULT_MAX_INFLUENCES = 0
+#: Default name of the target's vertex group whose members are always
+#: inpainted, never copied (an artist-painted mask).
+DEFAULT_MASK_GROUP = "AutoRig Inpaint"
+#: Vertices with at least this weight in the mask or protect vertex group
+#: count as its members (weights are in [0, 1]).
+GROUP_MEMBER_THRESHOLD = 0.5
+
+
+@dataclass(frozen=True)
+class TransferOptions:
+    """Settings of :func:`~autorig_addon.core.transfer.transfer.transfer_weights`.
+
+    Attributes
+    ----------
+    distance_fraction : float
+        Match distance ``D`` as a fraction of the target bounding-box diagonal.
+    max_distance : float or None
+        Absolute ``D`` in scene units; overrides ``distance_fraction``.
+    max_normal_angle : float
+        Largest angle, in degrees, between the target normal and the source
+        normal at the closest point for a match.
+    accept_flipped_normals : bool
+        Second matching pass that accepts opposite normals (inner layers,
+        single-sided cloth modelled facing inwards).
+    smoothing_iterations : int
+        Laplacian smoothing passes over inpainted vertices after solving.
+    smoothing_strength : float
+        Blend factor in [0, 1] of each smoothing pass.
+    max_influences : int
+        Keep this many largest weights per vertex (0: no limit; 4 for most
+        game engines).
+    """
+
+    distance_fraction: float = DEFAULT_DISTANCE_FRACTION
+    max_distance: float | None = None
+    max_normal_angle: float = DEFAULT_MAX_NORMAL_ANGLE
+    accept_flipped_normals: bool = DEFAULT_ACCEPT_FLIPPED_NORMALS
+    smoothing_iterations: int = DEFAULT_SMOOTHING_ITERATIONS
+    smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
+    max_influences: int = DEFAULT_MAX_INFLUENCES

@@ -1,0 +1,130 @@
+"""Writing weights into vertex groups and binding to the armature
+(autorig_addon.blender.weight_writer), real bpy."""
+
+import math
+import re
+
+import bpy
+import numpy as np
+import pytest
+from mathutils import Euler
+
+from autorig_addon.blender import convert, weight_writer
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.types import Weights
+from blender_fixtures import (
+    LOWER_BONE,
+    UPPER_BONE,
+    box_geometry,
+    build_rig_scene,
+    group_weights,
+    make_armature,
+    mesh_object,
+)
+
+
+def random_weights(vertex_count, names, seed=0):
+    rng = np.random.default_rng(seed)
+    matrix = rng.random((vertex_count, len(names)))
+    matrix[rng.random(matrix.shape) < 0.3] = 0.0
+    return Weights(matrix, names)
+
+
+def test_fill_group_adds_each_vertex_with_its_weight(clean_scene):
+    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
+    box = mesh_object("Box", vertices, faces)
+    group = box.vertex_groups.new(name="Group")
+    # Repeated values share one add() call; the order of the indices must not matter.
+    weight_writer.fill_group(group, np.array([6, 1, 3, 0]), np.array([0.25, 0.5, 0.25, 1.0]))
+    np.testing.assert_allclose(group_weights(box, ["Group"])[:, 0], [1.0, 0.5, 0, 0.25, 0, 0, 0.25, 0])
+    weight_writer.clear_group(group, 8)
+    assert not any(vertex.groups for vertex in box.data.vertices)
+
+
+def test_write_weights_round_trip_preserves_other_groups_and_skips_zeros(clean_scene):
+    rig = build_rig_scene()
+    sleeve = rig.sleeve
+    keep = sleeve.vertex_groups.new(name="Keep")
+    keep.add([0, 1, 2], 0.75, "REPLACE")
+    stale = sleeve.vertex_groups.new(name=LOWER_BONE)
+    stale.add(list(range(len(sleeve.data.vertices))), 0.1, "REPLACE")
+    weights = random_weights(len(sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
+
+    weight_writer.write_weights(sleeve, weights, rig.armature)
+
+    read_back = convert.read_weights(sleeve, weights.bone_names).matrix
+    np.testing.assert_allclose(read_back, weights.matrix, atol=1e-6)
+    lower_index = sleeve.vertex_groups[LOWER_BONE].index
+    members = sum(any(g.group == lower_index for g in v.groups) for v in sleeve.data.vertices)
+    assert members == np.count_nonzero(weights.matrix[:, 0])  # zeros (and the stale 0.1) are gone
+    np.testing.assert_allclose(group_weights(sleeve, ["Keep"])[:3, 0], 0.75)
+    assert group_weights(sleeve, ["Keep"])[3:].sum() == 0.0
+
+
+def test_write_weights_never_writes_non_deform_or_unknown_bones(clean_scene):
+    armature = make_armature(deform_upper=False)
+    vertices, faces = box_geometry((0.0, 0.0, 0.5), 0.3)
+    box = mesh_object("Box", vertices, faces)
+    weights = Weights(np.full((8, 3), 1.0 / 3.0), (LOWER_BONE, UPPER_BONE, "NotABone"))
+    weight_writer.write_weights(box, weights, armature)
+    assert [group.name for group in box.vertex_groups] == [LOWER_BONE]
+    np.testing.assert_allclose(group_weights(box, [LOWER_BONE])[:, 0], 1.0 / 3.0, atol=1e-7)
+
+
+def test_write_weights_replace_all_keeps_only_listed_groups(clean_scene):
+    rig = build_rig_scene()
+    for name in ("Pin", "AutoRig Inpaint"):
+        rig.sleeve.vertex_groups.new(name=name).add([0], 1.0, "REPLACE")
+    weights = random_weights(len(rig.sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
+    weight_writer.write_weights(rig.sleeve, weights, rig.armature, replace_all=True, keep_groups=["AutoRig Inpaint"])
+    assert sorted(group.name for group in rig.sleeve.vertex_groups) == ["AutoRig Inpaint", LOWER_BONE, UPPER_BONE]
+    assert group_weights(rig.sleeve, ["AutoRig Inpaint"])[0, 0] == 1.0
+
+
+def test_write_weights_binds_once_and_keeps_world_transform(clean_scene):
+    rig = build_rig_scene()
+    rig.armature.location = (0.0, 1.0, 0.0)
+    rig.armature.rotation_euler = Euler((0.0, 0.0, math.radians(30)))
+    sleeve = rig.sleeve
+    sleeve.location = (0.2, 0.1, -0.3)
+    sleeve.scale = (1.5, 1.5, 1.5)
+    sleeve.modifiers.new("Smooth", "SUBSURF")
+    bpy.context.view_layer.update()
+    world_before = np.array(sleeve.matrix_world)
+    weights = random_weights(len(sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
+
+    weight_writer.write_weights(sleeve, weights, rig.armature)
+    weight_writer.write_weights(sleeve, weights, rig.armature)
+    bpy.context.view_layer.update()
+
+    armature_modifiers = [m for m in sleeve.modifiers if m.type == "ARMATURE"]
+    assert [(m.name, m.object) for m in armature_modifiers] == [(weight_writer.ARMATURE_MODIFIER_NAME, rig.armature)]
+    assert sleeve.modifiers[0].type == "ARMATURE"  # deforms before the subdivision
+    assert sleeve.parent == rig.armature
+    np.testing.assert_allclose(np.array(sleeve.matrix_world), world_before, atol=1e-6)
+
+
+def test_rebinding_retargets_one_modifier_and_removes_the_others(clean_scene):
+    scene = build_rig_scene(with_button=False)
+    other = make_armature("Other")
+    extra = scene.body.modifiers.new("Second", "ARMATURE")
+    extra.object = scene.armature
+    weight_writer.ensure_armature_binding(scene.body, other)
+    assert [(m.name, m.type, m.object.name) for m in scene.body.modifiers] == [("Armature", "ARMATURE", "Other")]
+    assert scene.body.parent == other
+
+
+def test_write_weights_refuses_bad_input_before_changing_anything(clean_scene):
+    rig = build_rig_scene()
+    groups_before = [group.name for group in rig.sleeve.vertex_groups]
+    with pytest.raises(InputError, match=re.escape(
+            "'Sleeve' has 552 vertices but the weights have 3 rows; "
+            "the mesh changed since the weights were computed.")):
+        weight_writer.write_weights(rig.sleeve, Weights(np.ones((3, 1)), (LOWER_BONE,)), rig.armature)
+    with pytest.raises(InputError, match=re.escape(
+            "The target 'Armature' is not a mesh (its type is Armature): pick a mesh object.")):
+        weight_writer.write_weights(rig.armature, Weights(np.ones((3, 1)), (LOWER_BONE,)), rig.armature)
+    with pytest.raises(InputError, match="^'Body' is not an armature object.$"):
+        weight_writer.write_weights(rig.sleeve, Weights(np.ones((552, 1)), (LOWER_BONE,)), rig.body)
+    assert [group.name for group in rig.sleeve.vertex_groups] == groups_before
+    assert len(rig.sleeve.modifiers) == 0 and rig.sleeve.parent is None
