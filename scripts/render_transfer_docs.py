@@ -27,10 +27,8 @@ from mathutils import Vector  # noqa: E402
 from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights  # noqa: E402
 from autorig_addon.blender.status_attribute import write_status_attribute  # noqa: E402
 from autorig_addon.blender.weight_writer import write_weights  # noqa: E402
-from autorig_addon.core.geometry.closest_point import TriangleMeshQuery  # noqa: E402
-from autorig_addon.core.transfer.transfer import transfer_weights  # noqa: E402
-from autorig_addon.core.types import Weights  # noqa: E402
-from autorig_addon.core.weights import normalize_rows  # noqa: E402
+from autorig_addon.core.transfer import transfer_weights  # noqa: E402
+from autorig_addon.core.transfer.matching import closest_point_weights  # noqa: E402
 from docs_render import duplicate, heat_colors, render, save_side_by_side, set_colors, set_pose, setup_render  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
@@ -40,11 +38,6 @@ POSE = [
     ("upperleg01.R", "X", 30.0),
     ("lowerleg01.R", "X", 35.0),
 ]
-
-
-def closest_point_weights(source, source_weights: Weights, target) -> Weights:
-    surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    return Weights(normalize_rows(surface.interpolate(source.triangles, source_weights.matrix)), source_weights.bone_names)
 
 
 def main(argv=None) -> int:

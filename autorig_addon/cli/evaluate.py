@@ -147,12 +147,9 @@ def _geometric(task: SkinInput):
 
 
 def _closest_point_transfer(source, source_weights, target):
-    from ..core.geometry.closest_point import TriangleMeshQuery
-    from ..core.types import Weights
-    from ..core.weights import normalize_rows
+    from ..core.transfer.matching import closest_point_weights
 
-    points = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    return Weights(normalize_rows(points.interpolate(source.triangles, source_weights.matrix)), source_weights.bone_names)
+    return closest_point_weights(source, source_weights, target)
 
 
 def _robust_transfer(source, source_weights, target):

@@ -153,14 +153,6 @@ def write_skin(plan: SkinPlan, weights: Weights) -> None:
                           replace_all=plan.settings.replace_all)
 
 
-def run_skin(armature, meshes: list, settings: SkinSettings, depsgraph, progress: ProgressCallback | None = None) -> Weights:
-    """Plan, compute and write in one call (scripts and the command line)."""
-    plan = plan_skin(armature, meshes, settings, depsgraph)
-    weights = compute_skin(plan, progress)
-    write_skin(plan, weights)
-    return weights
-
-
 def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
     """The armature and meshes to skin: named ones, else the selection
     (the active or selected armature and the selected meshes)."""

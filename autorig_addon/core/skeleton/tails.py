@@ -33,6 +33,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.bounding_box import bounding_box_diagonal
 from ..types import Skeleton
 from .hierarchy import descendant_counts
 
@@ -165,10 +166,6 @@ def _listed(names: Sequence[str]) -> str:
     return shown + (f" and {len(quoted) - MAX_LISTED_BONES} more" if len(quoted) > MAX_LISTED_BONES else "")
 
 
-def _extent(points: np.ndarray) -> float:
-    return float(np.linalg.norm(points.max(0) - points.min(0))) if len(points) else 0.0
-
-
 def _unit_rows(vectors: np.ndarray) -> np.ndarray:
     """Rows scaled to length 1; zero or non-finite rows become NaN."""
     lengths = np.linalg.norm(vectors, axis=1)
@@ -180,7 +177,7 @@ def _unit_rows(vectors: np.ndarray) -> np.ndarray:
 
 def _children_apart(joints: np.ndarray, parents: np.ndarray) -> list:
     """For each joint the array of its children not at its own place."""
-    tolerance = COINCIDENT_FRACTION * _extent(joints)
+    tolerance = COINCIDENT_FRACTION * bounding_box_diagonal(joints)
     children = [[] for _ in range(len(joints))]
     for j, parent in enumerate(parents):
         if parent >= 0 and np.linalg.norm(joints[j] - joints[parent]) > tolerance:
@@ -214,7 +211,7 @@ def continued_children(joints: np.ndarray, parents: np.ndarray) -> tuple[np.ndar
     joints = np.asarray(joints, dtype=np.float64).reshape(-1, 3)
     parents = np.asarray(parents, dtype=np.int64).reshape(-1)
     count = len(joints)
-    tolerance = COINCIDENT_FRACTION * _extent(joints)
+    tolerance = COINCIDENT_FRACTION * bounding_box_diagonal(joints)
     descendants = descendant_counts(parents)
     incoming = np.zeros((count, 3))
     for j in range(count):
@@ -392,7 +389,7 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
     InputError when a point-like deform bone has no child to point at.
     """
     if not (np.isfinite(size) and size > 0):
-        size = max(_extent(np.vstack([skeleton.joints, skeleton.tails])), 1e-12)
+        size = max(bounding_box_diagonal(np.vstack([skeleton.joints, skeleton.tails])), 1e-12)
     assessment = assess_stored_tails(skeleton, size)
     if not assessment.usable:
         stored_directions = skeleton.tails - skeleton.joints

@@ -13,6 +13,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from ..geometry.bounding_box import bounding_box_diagonal
 from ..geometry.laplacian import cotangent_laplacian, voronoi_mass
 
 
@@ -32,8 +33,7 @@ def inpainting_operator(V: np.ndarray, F: np.ndarray) -> sp.csr_matrix:
     -------
     Q : (n, n) scipy.sparse.csr_matrix; ``Q @ 1 = 0``
     """
-    diagonal = np.linalg.norm(V.max(0) - V.min(0)) if len(V) else 1.0
-    Vn = V / max(diagonal, 1e-300)
+    Vn = V / max(bounding_box_diagonal(V), 1e-300)
     L = cotangent_laplacian(Vn, F)
     mass = voronoi_mass(Vn, F)
     inverse_mass = np.divide(1.0, mass, out=np.zeros_like(mass), where=mass > 0)
