@@ -76,6 +76,9 @@ def test_load_character_reads_mesh_skeleton_and_weights(clean_scene, tmp_path, e
     assert character.unweighted_count == 0
     assert character.size == pytest.approx(BODY_SIZE, rel=1e-5)
     assert any("Sleeve" in note and "left out" in note for note in character.notes)
+    # Real one-metre bones: their stored tails are kept, and the notes say so.
+    assert any(note.startswith("stored bone tails used") for note in character.notes)
+    np.testing.assert_allclose(character.skeleton.tails[0], [0, 0, 1], atol=1e-5)
 
 
 def test_loader_picks_the_armature_with_most_skinned_vertices(clean_scene, tmp_path):

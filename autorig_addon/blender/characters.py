@@ -99,7 +99,8 @@ class RiggedCharacter:
         (``core.skeleton.tails.with_reliable_tails``): glTF stores joints,
         not bones, and Blender's importer makes point-like bones of
         armatures scaled up (every Quaternius character), so those get
-        tails derived from the joints (heads unchanged) and a note says so.
+        tails derived from the joints (heads unchanged); a note says which
+        tails were used and why.
     weights : Weights
         ``(n, d)``, columns the deform bones in joint order, rows normalised;
         rows of vertices the file leaves unweighted are zero.
@@ -244,8 +245,7 @@ def read_character(name: str, path: str = "", category: str = "") -> RiggedChara
     weighted_bones = set(bone for bone, used in zip(deforming, carries_weight) if used)
     deform = np.array([bone in weighted_bones for bone in full_skeleton.names], dtype=bool)
     skeleton, tail_decision = with_reliable_tails(replace(full_skeleton, deform=deform), character_size(mesh.vertices))
-    if tail_decision.any_derived:
-        notes.append(tail_decision.note)
+    notes.append(tail_decision.note)
     deform_names = skeleton.deform_subset().names
     column_of = {bone: column for column, bone in enumerate(deforming)}
     matrix = normalize_rows(raw[:, [column_of[bone] for bone in deform_names]])
