@@ -1,7 +1,7 @@
 """Check that every rigged character deforms to itself at rest.
 
 For each file under the characters folder (default ``../shared/data/characters``
-next to the repository) it runs ``blender.characters.check_bind_pose`` and
+next to the repository) it runs ``blender.bind_pose.check_bind_pose`` and
 prints a markdown table: the largest vertex movement in REST position and in
 the file's default pose (share of the character size), the verdict and the
 reasons found. Importer messages go to stderr.
@@ -31,7 +31,7 @@ sys.path.insert(0, str(REPO))
 
 import bpy  # noqa: E402,F401  (Blender before the add-on's Blender modules)
 
-from autorig_addon.blender.characters import BIND_POSE_TOLERANCE, check_bind_pose  # noqa: E402
+from autorig_addon.blender.bind_pose import BIND_POSE_TOLERANCE, check_bind_pose  # noqa: E402
 from autorig_addon.cli.batch import stdout_to_stderr  # noqa: E402
 from autorig_addon.core.io.scene_formats import LOADABLE_EXTENSIONS  # noqa: E402
 

@@ -293,7 +293,7 @@ def write_point_like_gltf(path) -> None:
 def test_point_like_gltf_bones_get_tails_on_the_child_heads(clean_scene, tmp_path):
     import bpy
 
-    from autorig_addon.blender import characters, convert
+    from autorig_addon.blender import bone_heat, characters, convert
 
     path = tmp_path / "chain.gltf"
     write_point_like_gltf(path)
@@ -314,7 +314,7 @@ def test_point_like_gltf_bones_get_tails_on_the_child_heads(clean_scene, tmp_pat
     bones_before = [(bone.name, tuple(bone.tail_local)) for bone in armature.data.bones]
     objects_before = sorted(obj.name for obj in bpy.data.objects)
     armatures_before = len(bpy.data.armatures)
-    weights = characters.bone_heat_weights(character.mesh, skeleton, armature)
+    weights = bone_heat.bone_heat_weights(character.mesh, skeleton, armature)
     assert [(bone.name, tuple(bone.tail_local)) for bone in armature.data.bones] == bones_before
     assert sorted(obj.name for obj in bpy.data.objects) == objects_before
     assert len(bpy.data.armatures) == armatures_before

@@ -9,9 +9,10 @@ import bpy
 import numpy as np
 import pytest
 
-from autorig_addon.blender import characters, scene_io
+from autorig_addon.blender import bind_pose, bone_heat, characters, scene_io, simplify
 from autorig_addon.core import dataset
 from autorig_addon.core.errors import InputError
+from autorig_addon.core.geometry.weld import weld_seams
 from autorig_addon.core.types import Mesh
 from blender_fixtures import (
     BODY_HEIGHT,
@@ -130,7 +131,7 @@ def test_file_without_skinned_mesh_is_an_input_error(clean_scene, tmp_path):
 def test_good_rig_deforms_to_itself(clean_scene, tmp_path, extension):
     path = tmp_path / f"good{extension}"
     save_rig(path)
-    check = characters.check_bind_pose(path)
+    check = bind_pose.check_bind_pose(path)
     assert check.deforms_to_itself and check.rest_error < 1e-6
     assert check.reasons == ()
     # glTF export splits the 506 vertices along the fixture's flat-shaded edges.
@@ -146,7 +147,7 @@ def test_skeleton_moved_after_binding_is_caught(clean_scene, tmp_path):
     save_rig(path)
     # The Upper joint's node moves 0.5 sideways; its inverse bind matrix stays.
     patch_glb_node(path, UPPER_BONE, [0.5, 1.0, 0.0])
-    check = characters.check_bind_pose(path)
+    check = bind_pose.check_bind_pose(path)
     # Vertices weighted wholly to Upper move by exactly 0.5.
     assert check.pose_error == pytest.approx(0.5 / BODY_SIZE, rel=1e-4)
     assert check.rest_error < 1e-6
@@ -168,7 +169,7 @@ def test_animation_is_not_taken_for_the_default_pose(clean_scene, tmp_path):
     save_rig(path, animate)
     scene_io.load_scene(path)
     assert bpy.data.actions, "the fixture must carry an animation"
-    check = characters.check_bind_pose(path)
+    check = bind_pose.check_bind_pose(path)
     assert check.deforms_to_itself, check
 
 
@@ -185,7 +186,7 @@ def test_shape_keys_and_modifiers_before_the_armature_are_reasons(clean_scene, t
 
     path = tmp_path / "keys.blend"
     save_rig(path, add_shape_key_and_displace)
-    check = characters.check_bind_pose(path)
+    check = bind_pose.check_bind_pose(path)
     # The key widens x by half: the widest vertex moves 0.5 * 0.3.
     assert check.rest_error == pytest.approx(0.15 / BODY_SIZE, rel=1e-4)
     assert any("Fat" in reason for reason in check.reasons)
@@ -206,10 +207,10 @@ def test_simplify_hits_the_target_and_carries_weights(clean_scene):
     split_weights = type(character.weights)(
         np.vstack([character.weights.matrix, character.weights.matrix[seams]]), character.weights.bone_names
     )
-    welded, welded_weights = characters.weld_seams(split, split_weights)
+    welded, welded_weights = weld_seams(split, split_weights)
     assert welded.vertex_count == mesh.vertex_count
-    simple, simple_weights = characters.simplify(split, split_weights, 200)
-    assert abs(simple.vertex_count - 200) <= characters.SIMPLIFY_COUNT_TOLERANCE * 200
+    simple, simple_weights = simplify.simplify(split, split_weights, 200)
+    assert abs(simple.vertex_count - 200) <= simplify.SIMPLIFY_COUNT_TOLERANCE * 200
     assert simple_weights.matrix.shape == (simple.vertex_count, 2)
     np.testing.assert_allclose(simple_weights.matrix.sum(axis=1), 1.0)
     # The body's weights are linear in z between rings, and the collapse
@@ -218,8 +219,8 @@ def test_simplify_hits_the_target_and_carries_weights(clean_scene):
     assert "AutoRig scratch" not in bpy.data.objects and "AutoRig scratch" not in bpy.data.meshes
     assert rig.body.name in bpy.data.objects
     # A target above the welded count refines first: same shape, same weights.
-    dense, dense_weights = characters.simplify(split, split_weights, 1500)
-    assert abs(dense.vertex_count - 1500) <= characters.SIMPLIFY_COUNT_TOLERANCE * 1500
+    dense, dense_weights = simplify.simplify(split, split_weights, 1500)
+    assert abs(dense.vertex_count - 1500) <= simplify.SIMPLIFY_COUNT_TOLERANCE * 1500
     radial = np.linalg.norm(dense.vertices[:, :2], axis=1)
     assert radial.max() <= BODY_RADIUS + 1e-6 and dense.vertices[:, 2].min() >= -1e-6
     np.testing.assert_allclose(dense_weights.matrix, expected_body_weights(dense.vertices[:, 2]), atol=0.05)
@@ -230,7 +231,7 @@ def test_bone_heat_weights_on_a_copy(clean_scene):
     rig = build_rig_scene(with_button=False)
     character = characters.read_character("body")
     objects_before = sorted(obj.name for obj in bpy.data.objects)
-    weights = characters.bone_heat_weights(character.mesh, character.skeleton, rig.armature)
+    weights = bone_heat.bone_heat_weights(character.mesh, character.skeleton, rig.armature)
     assert sorted(obj.name for obj in bpy.data.objects) == objects_before
     assert weights.bone_names == (LOWER_BONE, UPPER_BONE)
     # Bone heat reached every vertex; its rows are close to, not exactly, one.

@@ -126,7 +126,7 @@ def register_transfer_method(name: str, predict: Callable, description: str) -> 
 def _bone_heat(task: SkinInput):
     import bpy
 
-    from ..blender.characters import bone_heat_weights
+    from ..blender.bone_heat import bone_heat_weights
 
     armature = bpy.data.objects.get(task.armature_name) if task.armature_name else None
     if armature is None:

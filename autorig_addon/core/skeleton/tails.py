@@ -28,12 +28,13 @@ never changed: only the arrays passed to the core.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Optional, Sequence
+from typing import Optional
 
 import numpy as np
 
 from ..errors import InputError
 from ..geometry.bounding_box import bounding_box_diagonal
+from ..messages import listed_names
 from ..types import Skeleton
 from .hierarchy import descendant_counts
 
@@ -87,8 +88,6 @@ MIN_MEDIAN_REACH = 0.5
 #: share of the character size is point-like (0.2 mm on a 2 m character):
 #: it gets a derived tail when it has a child, else a deform bone is refused.
 POINT_LIKE_FRACTION = 1e-4
-#: Bones listed by name in a note or message before "and N more".
-MAX_LISTED_BONES = 5
 
 
 @dataclass(frozen=True)
@@ -160,10 +159,9 @@ class TailAssessment:
         return bool(self.direction_agreement >= MIN_DIRECTION_AGREEMENT)  # False for NaN
 
 
-def _listed(names: Sequence[str]) -> str:
-    quoted = [f"'{name}'" for name in names]
-    shown = ", ".join(quoted[:MAX_LISTED_BONES])
-    return shown + (f" and {len(quoted) - MAX_LISTED_BONES} more" if len(quoted) > MAX_LISTED_BONES else "")
+def _percent(share: float) -> str:
+    """``share`` as a percentage with two significant digits, never in exponent form."""
+    return f"{float(f'{100 * share:.2g}'):g} %"
 
 
 def _unit_rows(vectors: np.ndarray) -> np.ndarray:
@@ -344,8 +342,8 @@ def assess_stored_tails(skeleton: Skeleton, size: float) -> TailAssessment:
     agreement = float(np.mean(matches)) if matches else float("nan")
     short = median_fraction < MIN_MEDIAN_LENGTH_FRACTION
     falls_short = median_reach < MIN_MEDIAN_REACH  # False for NaN
-    length_words = f"median length {100 * median_fraction:.2g} % of the character"
-    reach_words = "" if np.isnan(median_reach) else f"reaching {100 * median_reach:.2g} % of the way to their child"
+    length_words = f"median length {_percent(median_fraction)} of the character"
+    reach_words = "" if np.isnan(median_reach) else f"reaching {_percent(median_reach)} of the way to their child"
     if short:
         reason = f"the stored bones are point-like ({length_words})"
     elif falls_short:
@@ -411,7 +409,7 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
         if len(names) == 1:
             message = f"Deform bone '{names[0]}' has zero length and no child to point at: give it a length"
         else:
-            message = f"Deform bones {_listed(names)} have zero length and no child to point at: give them a length"
+            message = f"Deform bones {listed_names(names, quoted=True)} have zero length and no child to point at: give them a length"
         raise InputError(f"{message} in Edit Mode.")
     fixed = np.flatnonzero(point_like & (child >= 0))
     if not len(fixed):
@@ -420,6 +418,6 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
     tails[fixed] = skeleton.joints[child[fixed]]
     names = tuple(skeleton.names[j] for j in fixed)
     one = len(names) == 1
-    reason = (f"{_listed(names)} {'is' if one else 'are'} shorter than {100 * POINT_LIKE_FRACTION:.2g} % of the "
+    reason = (f"{listed_names(names, quoted=True)} {'is' if one else 'are'} shorter than {100 * POINT_LIKE_FRACTION:.2g} % of the "
               f"character and now end{'s' * one} at {'its' if one else 'their'} child")
     return replace(skeleton, tails=tails), TailDecision(names, False, reason)

@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
-from ..weights import MAX_INFLUENCES
+from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH
 
 #: Default match distance ``D``, as a fraction of the target's bounding-box diagonal (paper: 0.05).
 DEFAULT_DISTANCE_FRACTION = 0.05
