@@ -123,6 +123,3 @@ SHARK = (
     ('jaw', 'jaw.master', (0.0000, -1.5791, 0.2788), (0.0000, -1.7326, 0.3041), True),
     ('jaw.001', 'jaw', (0.0000, -1.7326, 0.3041), (0.0000, -1.8860, 0.3294), True),
 )
-
-#: Template tables by name.
-TEMPLATES = {"human": HUMAN, "quadruped": QUADRUPED, "bird": BIRD, "shark": SHARK}
