@@ -170,7 +170,7 @@ def test_tilted_sheet_separates_the_two_sides_even_diagonally():
     (Mesh([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]], [[0, 1, 2]]), {},
      "The mesh has vertices at NaN or infinite positions; fix them before skinning."),
 ])
-def test_voxelize_rejects_bad_input(mesh, options, message):
+def test_voxelize_surface_rejects_bad_input(mesh, options, message):
     with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
         voxelize_surface(mesh, **options)
 
