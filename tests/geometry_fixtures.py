@@ -58,6 +58,24 @@ def two_bone_weights(mesh: Mesh, height: float = 1.0, blend: float = 0.2) -> Wei
     return Weights(np.stack([1 - upper, upper], axis=1), ("lower", "upper"))
 
 
+def small_humanoid() -> Skeleton:
+    """Hips, spine, head, two arms and two legs (joints j0..j8, z in [0.5, 1.8]);
+    size 2 when scaled by 1."""
+    joints = [
+        [0.0, 0.0, 1.0],   # 0 hips
+        [0.0, 0.0, 1.4],   # 1 chest
+        [0.0, 0.0, 1.8],   # 2 head
+        [0.3, 0.0, 1.4],   # 3 upper arm L
+        [0.6, 0.0, 1.4],   # 4 forearm L
+        [-0.3, 0.0, 1.4],  # 5 upper arm R
+        [-0.6, 0.0, 1.4],  # 6 forearm R
+        [0.1, 0.0, 0.5],   # 7 shin L
+        [-0.1, 0.0, 0.5],  # 8 shin R
+    ]
+    parents = [-1, 0, 1, 1, 3, 1, 5, 0, 0]
+    return Skeleton(np.asarray(joints), parents, tuple(f"j{k}" for k in range(len(parents))))
+
+
 def box_mesh(low, high, spacing: float) -> Mesh:
     """Closed axis-aligned box whose faces are grids of about ``spacing``,
     outward normals (faces are not welded to each other; the surface is

@@ -24,7 +24,14 @@ from autorig_addon.core.dataset.normalise import (
     normalise,
 )
 from autorig_addon.core.dataset.sample import SAMPLE_FORMAT_VERSION, CharacterSample
-from autorig_addon.core.dataset.split import category_of, read_data_split, relative_name, select_split
+from autorig_addon.core.dataset.split import (
+    DataItem,
+    category_of,
+    collect_data,
+    read_data_split,
+    relative_name,
+    select_split,
+)
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 from geometry_fixtures import cylinder
@@ -297,7 +304,43 @@ def test_relative_names(tmp_path):
     assert relative_name(path, tmp_path / "elsewhere") == "Fox"
 
 
+def test_collect_data_names_categorises_and_filters(tmp_path):
+    chars = tmp_path / "chars"
+    for relative in ("pack/a.glb", "pack/b.GLB", "top.obj", "notes/readme.txt"):
+        (chars / relative).parent.mkdir(parents=True, exist_ok=True)
+        (chars / relative).write_text("")
+    split_file = tmp_path / "split.json"
+    split_file.write_text(json.dumps({"train": ["pack/a.glb", "top.obj"], "validation": ["pack/b.GLB"],
+                                      "categories": {"biped": ["pack/a.glb"]}}))
+    a, b, top = chars / "pack" / "a.glb", chars / "pack" / "b.GLB", chars / "top.obj"
+    # A folder gives its loadable files (any case of extension), sorted and
+    # named by their path below it; the category is the split's, else the
+    # folder's, and "uncategorised" for a split entry at the top.
+    assert collect_data([str(chars)], "all", str(split_file)) == [
+        DataItem(a, "pack/a", "biped"), DataItem(b, "pack/b", "pack"), DataItem(top, "top", "uncategorised"),
+    ]
+    assert collect_data([str(chars)], "train", str(split_file)) == [
+        DataItem(a, "pack/a", "biped"), DataItem(top, "top", "uncategorised"),
+    ]
+    # A file is named by its stem; the split finds it by the end of its path.
+    assert collect_data([str(b)], "validation", str(split_file)) == [DataItem(b, "b", "pack")]
+    # The longest split entry that ends the path is the file's.
+    split_file.write_text(json.dumps({"train": ["a.glb", "pack/a.glb"], "validation": [],
+                                      "categories": {"loose": ["a.glb"], "biped": ["pack/a.glb"]}}))
+    assert collect_data([str(a)], "train", str(split_file)) == [DataItem(a, "a", "biped")]
+    # With "all", a broken split only loses its categories; a subset needs it.
+    split_file.write_text("{")
+    assert collect_data([str(a), str(top)], "all", str(split_file)) == [
+        DataItem(a, "a", "pack"), DataItem(top, "top", "chars"),
+    ]
+    with pytest.raises(InputError, match="'split.json' is not valid JSON"):
+        collect_data([str(a)], "train", str(split_file))
+    with pytest.raises(InputError, match=r"^No loadable file found in .*notes\.$"):
+        collect_data([str(chars / "notes")], "all", str(tmp_path / "none.json"))
+
+
 def test_package_exports_the_public_names():
     # blender.characters and the eval command use ``core.dataset`` as one namespace.
     assert dataset.CharacterSample is CharacterSample and dataset.build_samples is build_samples
     assert dataset.read_data_split is read_data_split and dataset.MIN_TARGET_VERTICES == 100
+    assert dataset.collect_data is collect_data and dataset.DataItem is DataItem

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import convert, scene_io
-from autorig_addon.cli import evaluate
+from autorig_addon.cli import evaluate, evaluation_methods
 from autorig_addon.cli.main import main
+from autorig_addon.core.dataset.split import collect_data
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.evaluation.self_transfer import self_transfer_target
 from autorig_addon.core.evaluation.skin_metrics import evaluate_skin, evaluate_transfer
@@ -181,7 +182,7 @@ def test_split_filters_the_data(clean_scene, tmp_path, capsys):
         rf"^No file under {dropped} is in the 'validation' split of split\.json \(its paths are relative to the "
         r"characters folder\): pass that folder, or use --split all\.$"
     )):
-        evaluate.collect_data([str(dropped)], "validation", str(tmp_path / "split.json"))
+        collect_data([str(dropped)], "validation", str(tmp_path / "split.json"))
 
 
 def test_rig_from_files_equal_to_the_reference(clean_scene, tmp_path, capsys):
@@ -270,7 +271,7 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
 )
 def test_unknown_methods_are_usage_errors(task, method, message, tmp_path, capsys):
     with pytest.raises(InputError) as raised:
-        evaluate.check_method(task, method)
+        evaluation_methods.check_method(task, method)
     assert str(raised.value) == message
     capsys.readouterr()
     # Through the command line: exit 2 before any file is read (the data need not exist).
@@ -296,7 +297,7 @@ def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys,
         top = mesh.vertices[:, 2].max()
         return Skeleton([[0, 0, 0], [0, 0, top / 2]], [-1, 0], ("root", "mid"))
 
-    monkeypatch.setitem(evaluate.RIG_METHODS, "halves", evaluate.Method(predict, "test"))
+    monkeypatch.setitem(evaluation_methods.RIG_METHODS, "halves", evaluation_methods.Method(predict, "test"))
     code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", "halves"], tmp_path, capsys)
     assert code == 0 and len(seen) == 1 and seen[0].vertex_count == 506
     assert report["characters"][0]["cd_j2j"] == 0.0

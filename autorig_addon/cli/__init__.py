@@ -13,7 +13,8 @@ subcommand runs):
 - :mod:`.exit_codes`: exit codes and :class:`~.exit_codes.UsageError`,
 - :mod:`.batch`: many inputs, a progress bar on stderr, a JSON summary on stdout,
 - :mod:`.arguments`: bounded numbers for argparse and options shared by subcommands,
-- :mod:`.transfer`, :mod:`.skin`, :mod:`.evaluate`, :mod:`.package`: one subcommand each.
+- :mod:`.transfer`, :mod:`.skin`, :mod:`.evaluate`, :mod:`.package`: one subcommand each,
+- :mod:`.evaluation_methods`: the methods ``eval`` scores, registered per task.
 """
 
 from .main import main

@@ -14,6 +14,11 @@ same as JSON::
      "summary": {"categories": {CATEGORY: {"count", "failed", "mean": {...}, "median": {...}}},
                  "overall": {...}}}
 
+The methods and their registries are in :mod:`.evaluation_methods`; the
+files are picked, named and categorised by
+``core.dataset.split.collect_data``. This module parses the arguments, runs
+the method on each file and writes the report.
+
 The method never sees what it is judged against: a skin method gets the
 mesh and the skeleton (bone heat runs on a copy built from the arrays, with
 no vertex group), a rig method the mesh alone, a transfer method the source
@@ -53,10 +58,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
+from ..core.dataset.split import DEFAULT_SPLIT_FILE, SUBSETS, DataItem, collect_data
 from ..core.errors import InputError
 from ..core.evaluation.report import markdown_report, summarise
-from ..core.io.scene_formats import LOADABLE_EXTENSIONS
 from .batch import stdout_to_stderr
+from .evaluation_methods import (
+    REFERENCE_METHOD,
+    SKIN_METHODS,
+    TRANSFER_METHODS,
+    SkinInput,
+    check_method,
+    method_names,
+    rig_predictor,
+)
 from .exit_codes import EXIT_FAILED, EXIT_OK, UsageError
 
 NAME = "eval"
@@ -64,109 +78,6 @@ HELP = "Score a skinning, rigging or transfer method against artist rigs"
 
 #: Task names, the first positional argument.
 TASKS = ("skin", "rig", "transfer")
-#: ``--split`` choices: subsets of ``data_split.json``.
-SPLITS = ("all", "train", "validation")
-#: Where the train/validation split lives: the repository's top folder.
-DEFAULT_SPLIT_FILE = Path(__file__).resolve().parents[2] / "data_split.json"
-#: Prefix of the rig method that reads predicted rigs from a folder.
-FILE_METHOD_PREFIX = "file:"
-
-
-# --------------------------------------------------------------------------- method registries
-
-
-@dataclass(frozen=True)
-class SkinInput:
-    """What a skin method may look at.
-
-    Attributes
-    ----------
-    mesh : core.types.Mesh, world space, rest pose
-    skeleton : core.types.Skeleton; weights go to its deform bones
-    armature_name : str, the armature object in the loaded scene (for
-        methods that run inside Blender), "" when there is none
-    """
-
-    mesh: object
-    skeleton: object
-    armature_name: str = ""
-
-
-@dataclass(frozen=True)
-class Method:
-    """A registered method: ``predict`` and a one-line description."""
-
-    predict: Callable
-    description: str
-
-
-#: skin methods: ``predict(SkinInput) -> Weights``.
-SKIN_METHODS: dict[str, Method] = {}
-#: rig methods: ``predict(mesh) -> Skeleton`` (world space of the mesh).
-RIG_METHODS: dict[str, Method] = {}
-#: transfer methods: ``predict(source_mesh, source_weights, target_mesh) -> Weights``.
-TRANSFER_METHODS: dict[str, Method] = {}
-
-_REGISTRIES = {"skin": SKIN_METHODS, "rig": RIG_METHODS, "transfer": TRANSFER_METHODS}
-
-
-def register_skin_method(name: str, predict: Callable, description: str) -> None:
-    SKIN_METHODS[name] = Method(predict, description)
-
-
-def register_rig_method(name: str, predict: Callable, description: str) -> None:
-    """Add a skeleton predictor: ``predict(mesh: Mesh) -> Skeleton``."""
-    RIG_METHODS[name] = Method(predict, description)
-
-
-def register_transfer_method(name: str, predict: Callable, description: str) -> None:
-    TRANSFER_METHODS[name] = Method(predict, description)
-
-
-def _bone_heat(task: SkinInput):
-    import bpy
-
-    from ..blender.bone_heat import bone_heat_weights
-
-    armature = bpy.data.objects.get(task.armature_name) if task.armature_name else None
-    if armature is None:
-        raise InputError("Bone heat needs the character's armature in the loaded scene.")
-    return bone_heat_weights(task.mesh, task.skeleton, armature)
-
-
-def _nearest_bone(task: SkinInput):
-    from ..core.skinning.nearest_bone import nearest_bone_weights
-
-    return nearest_bone_weights(task.mesh, task.skeleton)
-
-
-def _geometric(task: SkinInput):
-    from ..core.skinning.geometric import geometric_weights
-
-    return geometric_weights(task.mesh, task.skeleton)
-
-
-def _closest_point_transfer(source, source_weights, target):
-    from ..core.transfer.matching import closest_point_weights
-
-    return closest_point_weights(source, source_weights, target)
-
-
-def _robust_transfer(source, source_weights, target):
-    from ..core.transfer.transfer import transfer_weights
-
-    return transfer_weights(source, source_weights, target).weights
-
-
-register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
-register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
-register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
-register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
-register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")
-
-#: Skin method that returns the reference itself: a sanity check of the
-#: pipeline (its scores must be perfect), not a method.
-REFERENCE_METHOD = "reference"
 
 
 # --------------------------------------------------------------------------- arguments
@@ -174,16 +85,12 @@ REFERENCE_METHOD = "reference"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the ``eval`` arguments (no Blender needed)."""
-    methods = "; ".join(
-        f"{task}: " + ", ".join(sorted(registry) + ([REFERENCE_METHOD] if task == "skin" else [])
-                                + ([FILE_METHOD_PREFIX + "DIR"] if task == "rig" else []))
-        for task, registry in _REGISTRIES.items()
-    )
+    methods = "; ".join(f"{task}: " + ", ".join(method_names(task)) for task in TASKS)
     parser.add_argument("task", choices=TASKS, help="What to evaluate: skin weights, rigs (skeletons) or weight transfer")
     parser.add_argument("data", nargs="+", metavar="DATA", help="Rigged character files (.blend .glb .gltf .fbx) or folders of them; garments for transfer")
     parser.add_argument("--method", required=True, help=f"Method to evaluate ({methods})")
     parser.add_argument("--out", metavar="FILE", help="Write the JSON report to FILE")
-    parser.add_argument("--split", choices=SPLITS, default="all",
+    parser.add_argument("--split", choices=SUBSETS, default="all",
                         help="Keep only the files of this subset of the data split (default all)")
     parser.add_argument("--split-file", metavar="FILE", default=str(DEFAULT_SPLIT_FILE),
                         help="The data split (default: data_split.json at the repository top)")
@@ -194,80 +101,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="No per-character progress lines on stderr")
 
 
-# --------------------------------------------------------------------------- data selection
-
-
-@dataclass(frozen=True)
-class DataItem:
-    """One file to evaluate: its path, name and category."""
-
-    path: Path
-    name: str
-    category: str
-
-
-def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None) -> list[DataItem]:
-    """Files to evaluate, named and categorised.
-
-    A folder contributes every loadable file below it, named by its path
-    below the folder without extension; a file is named by its stem. With a
-    split other than ``all``, only files listed in that subset of the split
-    file are kept (matched by the end of their path, since the split holds
-    paths relative to the characters folder). Categories come from the
-    split when it lists the file, else from the folder holding the file.
-
-    Raises
-    ------
-    InputError when nothing is left to evaluate.
-    """
-    from ..core import dataset
-
-    split_path = Path(split_file) if split_file else DEFAULT_SPLIT_FILE
-    split = None
-    if split_name != "all":
-        split = dataset.read_data_split(split_path)
-    elif split_path.is_file():
-        try:
-            split = dataset.read_data_split(split_path)
-        except InputError:
-            split = None  # only used for categories here; the folder names serve as well
-    wanted = set(split.subset(split_name)) if split is not None else set()
-    items = []
-    for text in inputs:
-        root = Path(text)
-        if root.is_dir():
-            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]
-            names = [path.relative_to(root).with_suffix("").as_posix() for path in files]
-        elif root.is_file():
-            files, names = [root], [root.stem]
-        else:
-            raise InputError(f"'{text}' is neither a file nor a folder.")
-        for path, name in zip(files, names):
-            entry = _split_entry(path, split)
-            if split_name != "all" and entry not in wanted:
-                continue
-            category = dataset.category_of(entry, split) if entry is not None else path.parent.name
-            items.append(DataItem(path, name, category or "uncategorised"))
-    if not items:
-        where = ", ".join(inputs)
-        if split_name != "all":
-            raise InputError(
-                f"No file under {where} is in the '{split_name}' split of {split_path.name} "
-                "(its paths are relative to the characters folder): pass that folder, or use --split all."
-            )
-        raise InputError(f"No loadable file found in {where}.")
-    return items
-
-
-def _split_entry(path: Path, split) -> Optional[str]:
-    """The split's relative path naming ``path`` (the longest that ends it), if any."""
-    if split is None:
-        return None
-    text = path.resolve().as_posix()
-    matches = [entry for entry in split.subset("all") if text == entry or text.endswith("/" + entry)]
-    return max(matches, key=len) if matches else None
-
-
 # --------------------------------------------------------------------------- evaluation
 
 
@@ -275,43 +108,6 @@ def _predict_timed(predict: Callable, *args) -> tuple:
     started = time.perf_counter()
     result = predict(*args)
     return result, round(time.perf_counter() - started, 3)
-
-
-def _rig_predictor(method: str) -> Callable:
-    """``predict(mesh, item) -> Skeleton`` for a rig method name."""
-
-    if method.startswith(FILE_METHOD_PREFIX):
-        folder = Path(method[len(FILE_METHOD_PREFIX):])
-        if not folder.is_dir():
-            raise InputError(f"The folder of predicted rigs '{folder}' does not exist.")
-
-        def read_predicted(mesh, item: DataItem):
-            from ..core.io.rignet_rig import read_rignet_rig
-
-            candidates = [folder / f"{item.name}.txt", folder / f"{item.name}_rig.txt",
-                          folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
-            for candidate in candidates:
-                if candidate.is_file():
-                    return read_rignet_rig(candidate)[0]
-            raise InputError(f"No predicted rig for '{item.name}' in '{folder}' (looked for {candidates[0].name}).")
-
-        return read_predicted
-    if method not in RIG_METHODS:
-        raise InputError(f"Unknown rig method '{method}': use {FILE_METHOD_PREFIX}DIR or one of {sorted(RIG_METHODS) or 'none yet'}.")
-    predict = RIG_METHODS[method].predict
-    return lambda mesh, item: predict(mesh)
-
-
-def check_method(task: str, method: str) -> None:
-    """Raise InputError when ``method`` cannot run for ``task``."""
-
-    if task == "skin":
-        if method != REFERENCE_METHOD and method not in SKIN_METHODS:
-            raise InputError(f"Unknown skin method '{method}': use one of {sorted(SKIN_METHODS) + [REFERENCE_METHOD]}.")
-    elif task == "rig":
-        _rig_predictor(method)
-    elif method not in TRANSFER_METHODS:
-        raise InputError(f"Unknown transfer method '{method}': use one of {sorted(TRANSFER_METHODS)}.")
 
 
 def evaluate_skin_item(item: DataItem, method: str) -> dict:
@@ -336,7 +132,7 @@ def evaluate_rig_item(item: DataItem, method: str) -> dict:
     from ..core.evaluation.skeleton_metrics import evaluate_rig
 
     character = load_character(item.path, item.name, item.category)
-    predicted, seconds = _predict_timed(_rig_predictor(method), character.mesh, item)
+    predicted, seconds = _predict_timed(rig_predictor(method), character.mesh, item)
     return {**evaluate_rig(predicted, character.skeleton, character.size), "seconds": seconds,
             "notes": list(character.notes)}
 

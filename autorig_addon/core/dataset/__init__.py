@@ -3,8 +3,8 @@
 :mod:`.normalise` moves a character into RigNet's common frame,
 :mod:`.sample` stores one as a :class:`CharacterSample` (``.npz``),
 :mod:`.cache` builds samples of files once and reads them from the cache
-after, :mod:`.split` reads the train/validation split and names and
-categorises the files. The public names of all four are here too.
+after, :mod:`.split` reads the train/validation split, names and
+categorises the files and picks those of a subset. The public names of all four are here too.
 """
 
 from .cache import (
@@ -34,4 +34,14 @@ from .normalise import (
     normalise,
 )
 from .sample import SAMPLE_FORMAT_VERSION, CharacterSample
-from .split import DataSplit, category_of, read_data_split, relative_name, select_split
+from .split import (
+    DEFAULT_SPLIT_FILE,
+    SUBSETS,
+    DataItem,
+    DataSplit,
+    category_of,
+    collect_data,
+    read_data_split,
+    relative_name,
+    select_split,
+)

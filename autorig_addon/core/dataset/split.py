@@ -1,4 +1,9 @@
-"""The train/validation split of the rigged characters and their names and categories."""
+"""The train/validation split of the rigged characters and their names and categories.
+
+:func:`read_data_split` reads the split, :func:`relative_name` and
+:func:`category_of` name and categorise a file, and :func:`collect_data`
+picks the files of given files and folders that a subset of the split lists.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +14,13 @@ from pathlib import Path
 from typing import Optional, Sequence
 
 from ..errors import InputError
+from ..io.scene_formats import LOADABLE_EXTENSIONS
+
+#: Names of the subsets of a split: all its files, the training files and the
+#: validation files.
+SUBSETS = ("all", "train", "validation")
+#: Where the train/validation split lives: the repository's top folder.
+DEFAULT_SPLIT_FILE = Path(__file__).resolve().parents[3] / "data_split.json"
 
 
 @dataclass(frozen=True)
@@ -104,3 +116,86 @@ def select_split(relative_paths: Sequence[str], split: DataSplit, subset: str) -
     """Indices of ``relative_paths`` listed in ``split``'s ``subset``."""
     wanted = set(split.subset(subset))
     return [index for index, relative in enumerate(relative_paths) if Path(relative).as_posix() in wanted]
+
+
+@dataclass(frozen=True)
+class DataItem:
+    """One file to evaluate: its path, name and category."""
+
+    path: Path
+    name: str
+    category: str
+
+
+def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None) -> list[DataItem]:
+    """Files to evaluate, named and categorised.
+
+    A folder contributes every loadable file below it, named by its path
+    below the folder without extension; a file is named by its stem. With a
+    split other than ``all``, only files listed in that subset of the split
+    file are kept (matched by the end of their path, since the split holds
+    paths relative to the characters folder). Categories come from the
+    split when it lists the file, else from the folder holding the file.
+
+    Parameters
+    ----------
+    inputs : list of str
+        Files and folders.
+    split_name : str
+        One of :data:`SUBSETS`.
+    split_file : str, optional
+        The split; default :data:`DEFAULT_SPLIT_FILE`.
+
+    Returns
+    -------
+    items : list of DataItem
+        In the order of ``inputs``, a folder's files sorted by path.
+
+    Raises
+    ------
+    InputError when nothing is left to evaluate.
+    """
+    split_path = Path(split_file) if split_file else DEFAULT_SPLIT_FILE
+    split = None
+    if split_name != "all":
+        split = read_data_split(split_path)
+    elif split_path.is_file():
+        try:
+            split = read_data_split(split_path)
+        except InputError:
+            split = None  # only used for categories here; the folder names serve as well
+    wanted = set(split.subset(split_name)) if split is not None else set()
+    items = []
+    for text in inputs:
+        root = Path(text)
+        if root.is_dir():
+            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]
+            names = [path.relative_to(root).with_suffix("").as_posix() for path in files]
+        elif root.is_file():
+            files, names = [root], [root.stem]
+        else:
+            raise InputError(f"'{text}' is neither a file nor a folder.")
+        for path, name in zip(files, names):
+            entry = _split_entry(path, split)
+            if split_name != "all" and entry not in wanted:
+                continue
+            category = category_of(entry, split) if entry is not None else path.parent.name
+            items.append(DataItem(path, name, category or "uncategorised"))
+    if not items:
+        where = ", ".join(inputs)
+        if split_name != "all":
+            raise InputError(
+                f"No file under {where} is in the '{split_name}' split of {split_path.name} "
+                "(its paths are relative to the characters folder): pass that folder, or use --split all."
+            )
+        raise InputError(f"No loadable file found in {where}.")
+    return items
+
+
+def _split_entry(path: Path, split: Optional[DataSplit]) -> Optional[str]:
+    """The split's relative path naming ``path`` (the longest that ends it), if any."""
+    if split is None:
+        return None
+    text = path.resolve().as_posix()
+    matches = [entry for entry in split.subset("all") if text == entry or text.endswith("/" + entry)]
+    return max(matches, key=len) if matches else None

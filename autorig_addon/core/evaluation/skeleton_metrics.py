@@ -1,14 +1,12 @@
 """Metrics comparing a predicted skeleton with a reference skeleton.
 
-Follows the skeleton evaluation of RigNet (Xu et al. 2020):
-
-* CD-J2J, CD-J2B, CD-B2B: symmetric Chamfer distances between joints,
-  joints and bones, and bones and bones. Each is the mean of the two
-  one-way averages ``(mean_a d(a, B) + mean_b d(b, A)) / 2``.
-* Joint IoU, precision and recall after a one-to-one (Hungarian) matching of
-  predicted to reference joints within a distance tolerance.
-* Tree edit distance between the two hierarchies (independent of the order
-  in which child bones are listed).
+Follows the skeleton evaluation of RigNet (Xu et al. 2020). This module
+holds the symmetric Chamfer distances CD-J2J, CD-J2B and CD-B2B between
+joints, joints and bones, and bones and bones; each is the mean of the two
+one-way averages ``(mean_a d(a, B) + mean_b d(b, A)) / 2``.
+:func:`evaluate_rig` adds the joint IoU, precision and recall of
+:mod:`.joint_matching` and the hierarchy distance of
+:mod:`.tree_edit_distance`.
 
 A *bone* here is the segment from a joint's parent to the joint (RigNet's
 definition); Blender's tails of leaf bones are not used, because predicted
@@ -25,7 +23,6 @@ mesh (:func:`~..geometry.bounding_box.character_size`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -33,25 +30,17 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from ..geometry.bounding_box import checked_size
 from ..geometry.segments import point_segment_distances
-from ..skeleton.hierarchy import children_lists, descendant_counts, parents_first_order
 from ..types import Skeleton
+from .joint_matching import JOINT_MATCH_FRACTION, checked_joints, joint_iou_precision_recall
+from .tree_edit_distance import tree_edit_distance
 
 #: Joints closer than this share of the character size are one joint.
 COINCIDENT_JOINT_FRACTION = 1e-3
-
-#: A predicted joint matches a reference joint within this share of the
-#: character size. RigNet uses half the local shape diameter at the
-#: reference joint; for a 1.7 m human in A-pose (bounding-box diagonal about
-#: 2 m) this is 5 cm, about half the thickness of an upper arm.
-JOINT_MATCH_FRACTION = 0.025
 
 #: Spacing of the points sampled along bones for CD-B2B, as a share of the
 #: character size. RigNet steps 0.005 along bones of characters scaled to
 #: unit size.
 BONE_SAMPLE_FRACTION = 0.005
-
-#: Label of the virtual root that joins the trees of a forest.
-_FOREST_ROOT_LABEL = -1
 
 
 def merge_coincident_joints(skeleton: Skeleton, tolerance: float) -> Skeleton:
@@ -170,7 +159,8 @@ def chamfer_j2j(pred_joints: np.ndarray, ref_joints: np.ndarray, size: float = 1
     -------
     distance : float, in units of ``size``
     """
-    pred_joints, ref_joints = _points(pred_joints, "predicted joints"), _points(ref_joints, "reference joints")
+    pred_joints = checked_joints(pred_joints, "predicted joints")
+    ref_joints = checked_joints(ref_joints, "reference joints")
     return _symmetric_chamfer(pred_joints, ref_joints) / checked_size(size)
 
 
@@ -221,191 +211,6 @@ def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fracti
     return _symmetric_chamfer(pred_points, ref_points) / size
 
 
-
-
-def match_joints(pred_joints: np.ndarray, ref_joints: np.ndarray, tolerance: float | None = None) -> np.ndarray:
-    """One-to-one matching of predicted to reference joints (Hungarian).
-
-    Without ``tolerance``: the assignment of ``min(p, r)`` pairs with the
-    smallest total distance. With ``tolerance``: among assignments, the one
-    with the most pairs at distance ``<= tolerance``, ties broken by the
-    smallest total distance of those pairs; pairs farther apart are dropped.
-
-    Parameters
-    ----------
-    pred_joints : (p, 3) float64 array
-    ref_joints : (r, 3) float64 array
-    tolerance : float, optional
-        Largest distance of a matched pair, in the joints' units.
-
-    Returns
-    -------
-    matching : (p,) int64 array
-        Index of the matched reference joint per predicted joint, -1 if none.
-    """
-    pred_joints, ref_joints = _points(pred_joints, "predicted joints"), _points(ref_joints, "reference joints")
-    matching = np.full(len(pred_joints), -1, dtype=np.int64)
-    if not len(pred_joints) or not len(ref_joints):
-        return matching
-    distance = np.linalg.norm(pred_joints[:, None, :] - ref_joints[None, :, :], axis=2)
-    if tolerance is None:
-        rows, cols = linear_sum_assignment(distance)
-    else:
-        within = distance <= tolerance
-        # Any pair beyond tolerance costs more than all pairs within it
-        # together, so maximising the count of close pairs comes first.
-        beyond_cost = (min(distance.shape) + 1) * max(float(tolerance), 0.0) + 1.0
-        rows, cols = linear_sum_assignment(np.where(within, distance, beyond_cost))
-        keep = within[rows, cols]
-        rows, cols = rows[keep], cols[keep]
-    matching[rows] = cols
-    return matching
-
-
-def joint_iou_precision_recall(pred_joints: np.ndarray, ref_joints: np.ndarray, tolerance: float) -> dict:
-    """Joint IoU, precision and recall after matching within a tolerance.
-
-    With ``t`` the number of pairs of :func:`match_joints` (with
-    ``tolerance``): ``iou = t / (p + r - t)``, ``precision = t / p``,
-    ``recall = t / r``. An empty side gives 0 (1 when both are empty).
-
-    Parameters
-    ----------
-    pred_joints : (p, 3) float64 array
-    ref_joints : (r, 3) float64 array
-    tolerance : float
-        In the joints' units (see :data:`JOINT_MATCH_FRACTION`).
-
-    Returns
-    -------
-    dict with float values ``iou``, ``precision`` and ``recall`` in [0, 1].
-    """
-    pred_joints, ref_joints = _points(pred_joints, "predicted joints"), _points(ref_joints, "reference joints")
-    pred_count, ref_count = len(pred_joints), len(ref_joints)
-    if pred_count == 0 and ref_count == 0:
-        return {"iou": 1.0, "precision": 1.0, "recall": 1.0}
-    matched = int(np.count_nonzero(match_joints(pred_joints, ref_joints, tolerance) >= 0))
-    return {
-        "iou": matched / (pred_count + ref_count - matched),
-        "precision": matched / pred_count if pred_count else 0.0,
-        "recall": matched / ref_count if ref_count else 0.0,
-    }
-
-
-def tree_edit_distance(
-    pred_parents: np.ndarray, ref_parents: np.ndarray, matching: np.ndarray | None = None, labelled: bool = False
-) -> int:
-    """Edit distance between two joint hierarchies, independent of child order.
-
-    The constrained unordered tree edit distance of Zhang (1996): the least
-    number of joint insertions and deletions (and, with ``labelled``,
-    relabellings) that turns one hierarchy into the other, over mappings
-    that keep ancestors ancestors and send disjoint subtrees to disjoint
-    subtrees. Sibling order plays no part, so listing bones in another
-    order changes nothing. (RigNet uses an ordered distance, APTED, on the
-    order the bones are stored in, which does depend on it; both give the
-    same result on chains.) Forests (several roots) are joined under one
-    virtual root on each side, which costs nothing.
-
-    By default only the hierarchy counts, as in RigNet (zero rename cost):
-    identical shapes give 0 and a chain against the same chain with one
-    extra leaf gives 1. With ``labelled``, reference joint ``r`` has label
-    ``r``, a predicted joint the label of its matched reference joint (or
-    one of its own when unmatched), and mapping joints with different
-    labels costs 1 as well.
-
-    Parameters
-    ----------
-    pred_parents : (p,) int64 array
-        Parent index per predicted joint, -1 for roots.
-    ref_parents : (r,) int64 array
-        Parent index per reference joint, -1 for roots.
-    matching : (p,) int64 array, optional
-        Reference joint matched to each predicted joint, -1 for none
-        (e.g. :func:`match_joints`); required with ``labelled``.
-    labelled : bool
-        Whether mapping joints with different labels costs 1.
-
-    Returns
-    -------
-    distance : int
-    """
-    pred_parents = np.asarray(pred_parents, dtype=np.int64).reshape(-1)
-    ref_parents = np.asarray(ref_parents, dtype=np.int64).reshape(-1)
-    if matching is None:
-        if labelled:
-            raise InputError("A labelled tree edit distance needs the joint matching.")
-        matching = np.full(len(pred_parents), -1, dtype=np.int64)
-    matching = np.asarray(matching, dtype=np.int64).reshape(-1)
-    if len(matching) != len(pred_parents):
-        raise InputError(f"The matching has {len(matching)} entries for {len(pred_parents)} predicted joints.")
-    if np.any(matching >= len(ref_parents)):
-        raise InputError("The matching refers to a reference joint that does not exist.")
-    matched = matching[matching >= 0]
-    if len(np.unique(matched)) != len(matched):
-        raise InputError("The matching uses a reference joint twice; it must be one-to-one.")
-    # Unmatched predicted joints get labels no reference joint has: -2, -3, ...
-    pred_labels = np.where(matching >= 0, matching, -2 - np.arange(len(matching)))
-    ref_labels = np.arange(len(ref_parents))
-    return constrained_tree_edit_distance(
-        pred_parents, pred_labels, ref_parents, ref_labels, relabel_cost=int(labelled)
-    )
-
-
-def constrained_tree_edit_distance(
-    parents_a: np.ndarray,
-    labels_a: np.ndarray,
-    parents_b: np.ndarray,
-    labels_b: np.ndarray,
-    relabel_cost: int = 1,
-) -> int:
-    """Zhang's (1996) constrained edit distance between unordered labelled forests.
-
-    Costs: insert 1, delete 1, relabel ``relabel_cost`` when the labels
-    differ, else 0. Each forest is joined under a virtual root (same label
-    on both sides). Subtree pairs are solved children first; the children of
-    two joints are paired by a minimum-cost assignment
-    (``scipy.optimize.linear_sum_assignment``). Time
-    ``O(|A| |B| (deg A + deg B) log(deg A + deg B))``.
-
-    Parameters
-    ----------
-    parents_a, parents_b : (n,) int64 array
-        Parent per node, -1 for roots; any node order, no cycles.
-    labels_a, labels_b : (n,) int64 array
-        Node labels, never equal to -1 (reserved for the virtual root).
-    relabel_cost : int
-        Cost of mapping a node onto one with another label (0 ignores labels).
-
-    Returns
-    -------
-    distance : int
-    """
-    parents_a, labels_a = _under_virtual_root(parents_a, labels_a)
-    parents_b, labels_b = _under_virtual_root(parents_b, labels_b)
-    children_a, children_b = children_lists(parents_a), children_lists(parents_b)
-    # Children before parents, so the virtual root comes last.
-    order_a, order_b = parents_first_order(parents_a)[::-1].tolist(), parents_first_order(parents_b)[::-1].tolist()
-    size_a, size_b = descendant_counts(parents_a) + 1, descendant_counts(parents_b) + 1
-    # tree[i, j]: distance between the subtrees at i and j; forest[i, j]:
-    # between their forests of children.
-    tree = np.zeros((len(children_a), len(children_b)), dtype=np.int64)
-    forest = np.zeros_like(tree)
-    for i in order_a:
-        kids_a = children_a[i]
-        for j in order_b:
-            kids_b = children_b[j]
-            forest[i, j] = _forest_distance(i, j, kids_a, kids_b, tree, forest, size_a, size_b)
-            best = forest[i, j] + relabel_cost * int(labels_a[i] != labels_b[j])
-            if kids_b:
-                # j is inserted; the subtree at i goes into one child's subtree.
-                best = min(best, size_b[j] + min(tree[i, t] - size_b[t] for t in kids_b))
-            if kids_a:
-                best = min(best, size_a[i] + min(tree[s, j] - size_a[s] for s in kids_a))
-            tree[i, j] = best
-    return int(tree[order_a[-1], order_b[-1]])
-
-
 def evaluate_rig(
     pred: Skeleton,
     ref: Skeleton,
@@ -425,7 +230,8 @@ def evaluate_rig(
     size : float
         The character's size: bounding-box diagonal of its rest mesh.
     match_fraction : float
-        Joint matching tolerance of IoU/precision/recall, share of ``size``.
+        Joint matching tolerance of IoU/precision/recall
+        (:func:`~.joint_matching.joint_iou_precision_recall`), share of ``size``.
     merge_fraction : float
         Coincident-joint tolerance, share of ``size``.
 
@@ -434,7 +240,7 @@ def evaluate_rig(
     dict with float values
         ``cd_j2j``, ``cd_j2b``, ``cd_b2b`` (in units of ``size``), ``iou``,
         ``precision``, ``recall`` (with tolerance ``match_fraction * size``)
-        and ``tree_edit`` (:func:`tree_edit_distance` of the hierarchies,
+        and ``tree_edit`` (:func:`~.tree_edit_distance.tree_edit_distance` of the hierarchies,
         unlabelled as in RigNet).
     """
     size = checked_size(size)
@@ -450,46 +256,6 @@ def evaluate_rig(
         "recall": overlap["recall"],
         "tree_edit": float(tree_edit_distance(pred.parents, ref.parents)),
     }
-
-
-def _forest_distance(i, j, kids_a, kids_b, tree, forest, size_a, size_b) -> int:
-    """Constrained distance between the forests of children of ``i`` and ``j``."""
-    inserted = size_b[j] - 1
-    deleted = size_a[i] - 1
-    if not kids_a or not kids_b:
-        return inserted + deleted
-    # The whole forest of i goes into the forest of one child of j (the
-    # rest of j's forest is inserted), or the other way round.
-    best = min(
-        inserted + min(forest[i, t] - (size_b[t] - 1) for t in kids_b),
-        deleted + min(forest[s, j] - (size_a[s] - 1) for s in kids_a),
-    )
-    # Or the children are paired one to one; an unpaired subtree is deleted
-    # or inserted whole. Pairing costs tree distance minus that, never > 0.
-    saving = tree[np.ix_(kids_a, kids_b)] - size_a[kids_a][:, None] - size_b[kids_b][None, :]
-    rows, cols = linear_sum_assignment(saving)
-    return int(min(best, inserted + deleted + saving[rows, cols].sum()))
-
-
-def _under_virtual_root(parents: np.ndarray, labels: np.ndarray) -> tuple:
-    """A forest joined under a virtual root, for tree distances.
-
-    Returns ``(parents, labels)`` with one more node, the virtual root (index
-    ``n``, label :data:`_FOREST_ROOT_LABEL`), parent of the former roots.
-    """
-    parents = np.asarray(parents, dtype=np.int64).reshape(-1)
-    labels = np.asarray(labels, dtype=np.int64).reshape(-1)
-    count = len(parents)
-    if len(labels) != count:
-        raise InputError("Each node needs one parent and one label.")
-    if np.any((parents < -1) | (parents >= count)):
-        raise InputError("A parent index refers to a node that does not exist.")
-    if np.any(labels == _FOREST_ROOT_LABEL):
-        raise InputError(f"Label {_FOREST_ROOT_LABEL} is reserved for the virtual root.")
-    rooted = np.append(np.where(parents < 0, count, parents), -1)
-    if len(parents_first_order(rooted)) != count + 1:
-        raise InputError("The parent array does not describe a forest (it has a cycle).")
-    return rooted, np.append(labels, _FOREST_ROOT_LABEL)
 
 
 def _deform_skeleton(skeleton: Skeleton, what: str) -> Skeleton:
@@ -509,10 +275,3 @@ def _symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray) -> float:
     a_to_b = cKDTree(points_b).query(points_a)[0].mean()
     b_to_a = cKDTree(points_a).query(points_b)[0].mean()
     return float(a_to_b + b_to_a) / 2.0
-
-
-def _points(points: np.ndarray, what: str) -> np.ndarray:
-    points = np.asarray(points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise InputError(f"The {what} must be an (n, 3) array, got shape {points.shape}.")
-    return points

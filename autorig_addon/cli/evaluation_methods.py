@@ -1,0 +1,182 @@
+"""The methods ``eval`` can score: one registry per task, and the built-in methods.
+
+A method is registered under a name with ``predict`` and a one-line
+description; ``--method NAME`` picks it. Learned networks register here too
+(:func:`register_rig_method` for a skeleton predictor). What ``predict``
+gets and returns, per task:
+
+skin
+    ``predict(SkinInput) -> Weights`` over the deform bones.
+rig
+    ``predict(mesh: Mesh) -> Skeleton`` in the world space of the mesh.
+transfer
+    ``predict(source_mesh, source_weights, target_mesh) -> Weights``.
+
+Besides the registered ones, ``--method reference`` (:data:`REFERENCE_METHOD`)
+returns a skin task's reference weights, and ``--method file:DIR``
+(:data:`FILE_METHOD_PREFIX`) reads predicted rigs from a folder.
+Built-in methods import what they run only when called, so ``--help`` does
+not load Blender.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from ..core.dataset.split import DataItem
+from ..core.errors import InputError
+
+#: Skin method that returns the reference itself: a sanity check of the
+#: pipeline (its scores must be perfect), not a method.
+REFERENCE_METHOD = "reference"
+#: Prefix of the rig method that reads predicted rigs from a folder.
+FILE_METHOD_PREFIX = "file:"
+
+
+@dataclass(frozen=True)
+class SkinInput:
+    """What a skin method may look at.
+
+    Attributes
+    ----------
+    mesh : core.types.Mesh, world space, rest pose
+    skeleton : core.types.Skeleton; weights go to its deform bones
+    armature_name : str, the armature object in the loaded scene (for
+        methods that run inside Blender), "" when there is none
+    """
+
+    mesh: object
+    skeleton: object
+    armature_name: str = ""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A registered method: ``predict`` and a one-line description."""
+
+    predict: Callable
+    description: str
+
+
+#: skin methods: ``predict(SkinInput) -> Weights``.
+SKIN_METHODS: dict[str, Method] = {}
+#: rig methods: ``predict(mesh) -> Skeleton`` (world space of the mesh).
+RIG_METHODS: dict[str, Method] = {}
+#: transfer methods: ``predict(source_mesh, source_weights, target_mesh) -> Weights``.
+TRANSFER_METHODS: dict[str, Method] = {}
+
+_REGISTRIES = {"skin": SKIN_METHODS, "rig": RIG_METHODS, "transfer": TRANSFER_METHODS}
+
+
+def register_skin_method(name: str, predict: Callable, description: str) -> None:
+    """Add a skin weight predictor: ``predict(SkinInput) -> Weights``."""
+    SKIN_METHODS[name] = Method(predict, description)
+
+
+def register_rig_method(name: str, predict: Callable, description: str) -> None:
+    """Add a skeleton predictor: ``predict(mesh: Mesh) -> Skeleton``."""
+    RIG_METHODS[name] = Method(predict, description)
+
+
+def register_transfer_method(name: str, predict: Callable, description: str) -> None:
+    """Add a weight transfer: ``predict(source_mesh, source_weights, target_mesh) -> Weights``."""
+    TRANSFER_METHODS[name] = Method(predict, description)
+
+
+def method_names(task: str) -> list[str]:
+    """What ``--method`` accepts for ``task``: the registered names, sorted,
+    then the pseudo-methods (``reference`` for skin, ``file:DIR`` for rig)."""
+    names = sorted(_REGISTRIES[task])
+    if task == "skin":
+        names.append(REFERENCE_METHOD)
+    if task == "rig":
+        names.append(FILE_METHOD_PREFIX + "DIR")
+    return names
+
+
+def rig_predictor(method: str) -> Callable:
+    """``predict(mesh, item: DataItem) -> Skeleton`` for a rig method name.
+
+    Raises
+    ------
+    InputError for an unknown method or a ``file:DIR`` folder that does not exist.
+    """
+    if method.startswith(FILE_METHOD_PREFIX):
+        folder = Path(method[len(FILE_METHOD_PREFIX):])
+        if not folder.is_dir():
+            raise InputError(f"The folder of predicted rigs '{folder}' does not exist.")
+
+        def read_predicted(mesh, item: DataItem):
+            from ..core.io.rignet_rig import read_rignet_rig
+
+            candidates = [folder / f"{item.name}.txt", folder / f"{item.name}_rig.txt",
+                          folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
+            for candidate in candidates:
+                if candidate.is_file():
+                    return read_rignet_rig(candidate)[0]
+            raise InputError(f"No predicted rig for '{item.name}' in '{folder}' (looked for {candidates[0].name}).")
+
+        return read_predicted
+    if method not in RIG_METHODS:
+        raise InputError(f"Unknown rig method '{method}': use {FILE_METHOD_PREFIX}DIR or one of {sorted(RIG_METHODS) or 'none yet'}.")
+    predict = RIG_METHODS[method].predict
+    return lambda mesh, item: predict(mesh)
+
+
+def check_method(task: str, method: str) -> None:
+    """Raise InputError when ``method`` cannot run for ``task``."""
+
+    if task == "skin":
+        if method != REFERENCE_METHOD and method not in SKIN_METHODS:
+            raise InputError(f"Unknown skin method '{method}': use one of {sorted(SKIN_METHODS) + [REFERENCE_METHOD]}.")
+    elif task == "rig":
+        rig_predictor(method)
+    elif method not in TRANSFER_METHODS:
+        raise InputError(f"Unknown transfer method '{method}': use one of {sorted(TRANSFER_METHODS)}.")
+
+
+# --------------------------------------------------------------------------- built-in methods
+
+
+def _bone_heat(task: SkinInput):
+    import bpy
+
+    from ..blender.bone_heat import bone_heat_weights
+
+    armature = bpy.data.objects.get(task.armature_name) if task.armature_name else None
+    if armature is None:
+        raise InputError("Bone heat needs the character's armature in the loaded scene.")
+    return bone_heat_weights(task.mesh, task.skeleton, armature)
+
+
+def _nearest_bone(task: SkinInput):
+    from ..core.skinning.nearest_bone import nearest_bone_weights
+
+    return nearest_bone_weights(task.mesh, task.skeleton)
+
+
+def _geometric(task: SkinInput):
+    from ..core.skinning.geometric import geometric_weights
+
+    return geometric_weights(task.mesh, task.skeleton)
+
+
+def _closest_point_transfer(source, source_weights, target):
+    from ..core.transfer.matching import closest_point_weights
+
+    return closest_point_weights(source, source_weights, target)
+
+
+def _robust_transfer(source, source_weights, target):
+    from ..core.transfer.transfer import transfer_weights
+
+    return transfer_weights(source, source_weights, target).weights
+
+
+register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
+register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
+register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
+register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
+register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")
