@@ -33,7 +33,7 @@ import bpy  # noqa: E402,F401  (Blender before the add-on's Blender modules)
 
 from autorig_addon.blender.bind_pose import BIND_POSE_TOLERANCE, check_bind_pose  # noqa: E402
 from autorig_addon.cli.batch import stdout_to_stderr  # noqa: E402
-from autorig_addon.core.io.scene_formats import LOADABLE_EXTENSIONS  # noqa: E402
+from autorig_addon.core.io.scene_formats import scene_files  # noqa: E402
 
 DEFAULT_FOLDER = REPO.parent / "shared" / "data" / "characters"
 
@@ -81,7 +81,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", metavar="FILE", help="Also write the results as JSON")
     args = parser.parse_args(argv)
     root = Path(args.folder)
-    files = [p for p in sorted(root.rglob("*")) if p.is_file() and p.suffix.lower() in LOADABLE_EXTENSIONS]
+    files = scene_files(root)
     rows, results = [], []
     for path in files:
         name = path.relative_to(root).as_posix()

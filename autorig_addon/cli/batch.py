@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ..core.io.scene_formats import LOADABLE_EXTENSIONS, SAVABLE_EXTENSIONS
+from ..core.io.scene_formats import LOADABLE_EXTENSIONS, SAVABLE_EXTENSIONS, scene_files
 from .exit_codes import EXIT_FAILED, EXIT_OK, UsageError
 
 #: Output formats of batch jobs, as ``--format`` choices: what ``scene_io.save_scene`` writes.
@@ -95,9 +95,7 @@ def expand_inputs(inputs: list[str]) -> tuple[list[tuple[Path, Path]], bool]:
         path = Path(text)
         if path.is_dir():
             is_batch = True
-            for found in sorted(path.rglob("*")):
-                if found.is_file() and found.suffix.lower() in LOADABLE_EXTENSIONS:
-                    items.append((found, found.relative_to(path)))
+            items.extend((found, found.relative_to(path)) for found in scene_files(path))
         else:
             items.append((path, Path(path.name)))
     if not items:

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Optional, Sequence
 
 from ..errors import InputError
-from ..io.scene_formats import LOADABLE_EXTENSIONS
+from ..io.scene_formats import scene_files
 
 #: Names of the subsets of a split: all its files, the training files and the
 #: validation files.
@@ -169,7 +169,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     for text in inputs:
         root = Path(text)
         if root.is_dir():
-            files = [path for path in sorted(root.rglob("*")) if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]
+            files = scene_files(root)
             names = [path.relative_to(root).with_suffix("").as_posix() for path in files]
         elif root.is_file():
             files, names = [root], [root.stem]
