@@ -1,6 +1,6 @@
 """AutoRig: automatic rigging, skinning and robust weight transfer for Blender.
 
-The package imports without Blender: ``core`` is plain numpy/scipy/torch and
+The package imports without Blender: ``core`` is plain numpy/scipy and
 ``blender`` (operators, panels, conversion) is imported only by ``register``.
 """
 

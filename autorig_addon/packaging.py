@@ -3,7 +3,8 @@
 The add-on's sources are ``autorig_addon/`` while ``blender_manifest.toml``
 sits at the repository top, so a build stages a temporary directory::
 
-    STAGE/__init__.py, core/, blender/, ...   contents of autorig_addon/
+    STAGE/__init__.py, core/, blender/, ...   contents of autorig_addon/ (less the
+                                              torch-only core/nn/training/)
     STAGE/blender_manifest.toml               platforms + wheels rewritten
     STAGE/wheels/*.whl                        the dependencies Blender lacks
 
@@ -36,6 +37,7 @@ from pathlib import Path
 from typing import Optional, Sequence
 
 from .core.errors import InputError
+from .core.nn import TRAINING_PACKAGE
 from .core.progress import ProgressCallback, report
 
 #: The add-on package directory; its contents become the extension's root.
@@ -58,6 +60,9 @@ PYTORCH_CPU_INDEX_URL = "https://download.pytorch.org/whl/cpu"
 TORCH_PURE_PYTHON_DEPENDENCIES = ("typing_extensions", "sympy", "mpmath")
 #: Default download cache, reused between builds (one sub-folder per platform).
 DEFAULT_WHEEL_CACHE = os.path.join("~", ".cache", "autorig_addon", "wheels")
+#: Add-on folders (relative to ``autorig_addon/``) left out of the extension:
+#: the torch-only training code, which nothing inside Blender imports.
+EXCLUDED_SOURCE_FOLDERS = (TRAINING_PACKAGE.replace(".", "/"),)
 
 
 class PackagingError(InputError):
@@ -241,7 +246,7 @@ def cached_wheel(cache_dir: str, request: WheelRequest) -> Optional[str]:
 def stage_extension(stage_dir: str, wheels_by_platform: dict[str, list[str]]) -> None:
     """Fill ``stage_dir`` with the add-on sources, the rewritten manifest and
     the wheels of every platform in ``wheels_by_platform``."""
-    shutil.copytree(ADDON_DIR, stage_dir, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"), dirs_exist_ok=True)
+    copy_addon_sources(stage_dir)
     wheel_dir = os.path.join(stage_dir, WHEELS_FOLDER)
     os.makedirs(wheel_dir, exist_ok=True)
     names = []
@@ -253,6 +258,19 @@ def stage_extension(stage_dir: str, wheels_by_platform: dict[str, list[str]]) ->
                 _link_or_copy(path, os.path.join(wheel_dir, name))
     manifest = manifest_text(MANIFEST_PATH.read_text(encoding="utf-8"), list(wheels_by_platform), names)
     Path(stage_dir, MANIFEST_FILENAME).write_text(manifest, encoding="utf-8")
+
+
+def copy_addon_sources(stage_dir: str) -> None:
+    """Copy ``autorig_addon/`` into ``stage_dir``, without caches and
+    without :data:`EXCLUDED_SOURCE_FOLDERS`."""
+    ignore_caches = shutil.ignore_patterns("__pycache__", "*.pyc")
+
+    def ignored(folder, names):
+        relative = Path(folder).relative_to(ADDON_DIR)
+        excluded = {name for name in names if (relative / name).as_posix() in EXCLUDED_SOURCE_FOLDERS}
+        return set(ignore_caches(folder, names)) | excluded
+
+    shutil.copytree(ADDON_DIR, stage_dir, ignore=ignored, dirs_exist_ok=True)
 
 
 def manifest_text(source_text: str, platforms: Sequence[str], wheel_names: Sequence[str]) -> str:

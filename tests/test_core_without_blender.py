@@ -1,28 +1,54 @@
 """Import guards: ``autorig_addon.core`` never loads Blender, and nothing the
-add-on loads when Blender registers it loads torch (which only the learned
-networks need, on demand).
+add-on loads when Blender registers it loads torch.
 
-Each check runs in a fresh interpreter, so modules this test session already
-imported cannot hide an import.
+torch is for training only: the torch-importing modules are exactly those
+of the training sub-package ``autorig_addon.core.nn.training``
+(``autorig_addon.core.nn.TRAINING_PACKAGE``). Every other module must import
+without torch, must not name torch or the training package in any import
+(a lazy import inside a function included), and the extension zip leaves
+the training package out.
+
+Each import check runs in a fresh interpreter, so modules this test session
+already imported cannot hide an import.
 """
 
+import ast
+import importlib.util
 import json
 import subprocess
 import sys
+from pathlib import Path
 
-# Lists every module of a package, recursively, then imports them all and
-# prints which of the watched top-level modules got loaded.
+from autorig_addon import packaging
+from autorig_addon.core.nn import TRAINING_PACKAGE
+
+#: The torch-only sub-package, as an absolute module name.
+TRAINING_MODULE = "autorig_addon." + TRAINING_PACKAGE
+
+# Imports every module of some packages, recursively, except the skipped
+# sub-packages (not even their __init__), then prints which of the watched
+# top-level modules got loaded.
 IMPORT_ALL_SCRIPT = """
 import importlib, json, pkgutil, sys
 
 packages, watched, register = sys.argv[1].split(","), sys.argv[2].split(","), sys.argv[3] == "register"
+skipped = set(filter(None, sys.argv[4].split(",")))
 names = []
-for package_name in packages:
+
+def import_tree(package_name):
     package = importlib.import_module(package_name)
     names.append(package_name)
-    for info in pkgutil.walk_packages(package.__path__, package_name + "."):
-        importlib.import_module(info.name)
-        names.append(info.name)
+    for info in pkgutil.iter_modules(package.__path__, package_name + "."):
+        if info.name in skipped:
+            continue
+        if info.ispkg:
+            import_tree(info.name)
+        else:
+            importlib.import_module(info.name)
+            names.append(info.name)
+
+for package_name in packages:
+    import_tree(package_name)
 if register:
     import autorig_addon
     autorig_addon.register()
@@ -31,9 +57,10 @@ print(json.dumps({"modules": names, "loaded": loaded}))
 """
 
 
-def import_everything(repository_root, packages, watched, register=False) -> dict:
+def import_everything(repository_root, packages, watched, register=False, skipped=()) -> dict:
     result = subprocess.run(
-        [sys.executable, "-c", IMPORT_ALL_SCRIPT, ",".join(packages), ",".join(watched), "register" if register else "-"],
+        [sys.executable, "-c", IMPORT_ALL_SCRIPT, ",".join(packages), ",".join(watched),
+         "register" if register else "-", ",".join(skipped)],
         cwd=repository_root, capture_output=True, text=True, timeout=300,
     )
     assert result.returncode == 0, result.stderr
@@ -41,20 +68,102 @@ def import_everything(repository_root, packages, watched, register=False) -> dic
 
 
 def test_every_core_module_imports_without_bpy(repository_root):
-    outcome = import_everything(repository_root, ["autorig_addon.core"], ["bpy", "mathutils", "bmesh"])
+    # The training modules too, where torch is installed to import them.
+    torch_present = importlib.util.find_spec("torch") is not None
+    outcome = import_everything(repository_root, ["autorig_addon.core"], ["bpy", "mathutils", "bmesh"],
+                                skipped=() if torch_present else (TRAINING_MODULE,))
     assert outcome["loaded"] == []
     # The walk reached the sub-packages' modules, not only the top level.
     assert {"autorig_addon.core.transfer.transfer", "autorig_addon.core.transfer.options",
             "autorig_addon.core.transfer.combine", "autorig_addon.core.weights",
-            "autorig_addon.core.errors"} <= set(outcome["modules"])
+            "autorig_addon.core.errors", "autorig_addon.core.nn.graph"} <= set(outcome["modules"])
+    if torch_present:
+        assert TRAINING_MODULE + ".aggregation" in outcome["modules"]
 
 
 def test_core_blender_and_register_never_import_torch(repository_root):
     outcome = import_everything(repository_root, ["autorig_addon.core", "autorig_addon.blender"], ["torch"],
-                                register=True)
+                                register=True, skipped=(TRAINING_MODULE,))
     assert outcome["loaded"] == []
     assert {"autorig_addon.blender.operators.transfer", "autorig_addon.blender.ui.properties",
-            "autorig_addon.blender.ui.panels"} <= set(outcome["modules"])
+            "autorig_addon.blender.ui.panels", "autorig_addon.core.nn.aggregation",
+            "autorig_addon.core.nn.weights_io"} <= set(outcome["modules"])
+    # Only the training package was left out.
+    assert not [name for name in outcome["modules"] if name.startswith(TRAINING_MODULE)]
+
+
+def imported_modules(path: Path, module_name: str) -> set:
+    """Absolute names of every module an ``import`` in the file names, at any
+    depth (imports inside functions included); for ``from X import a`` both
+    ``X`` and ``X.a``."""
+    is_package = path.name == "__init__.py"
+    package_parts = module_name.split(".") if is_package else module_name.split(".")[:-1]
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base_parts = package_parts[: len(package_parts) - node.level + 1] if node.level else []
+            base = ".".join(base_parts + ([node.module] if node.module else []))
+            names.add(base)
+            names.update(f"{base}.{alias.name}" for alias in node.names)
+    return names
+
+
+def addon_modules_blender_may_load(repository_root):
+    """(path, module name) of every add-on source Blender may import: all but
+    the command line and the training package."""
+    addon = Path(repository_root) / "autorig_addon"
+    for path in sorted(addon.rglob("*.py")):
+        parts = path.relative_to(addon.parent).with_suffix("").parts
+        module_name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        if module_name.startswith(("autorig_addon.cli", TRAINING_MODULE)):
+            continue
+        yield path, module_name
+
+
+def test_no_module_outside_training_names_torch_or_the_training_package(repository_root):
+    offenders = {}
+    checked = 0
+    for path, module_name in addon_modules_blender_may_load(repository_root):
+        checked += 1
+        bad = sorted(name for name in imported_modules(path, module_name)
+                     if name.split(".")[0] == "torch" or name == TRAINING_MODULE
+                     or name.startswith(TRAINING_MODULE + "."))
+        if bad:
+            offenders[module_name] = bad
+    assert offenders == {}
+    assert checked > 50
+
+
+def test_import_scan_resolves_relative_imports(tmp_path):
+    # The scan above must see a lazy relative import of the training package.
+    module = tmp_path / "layers.py"
+    module.write_text("def f():\n    from .training import aggregation\n    import torch.nn\n")
+    names = imported_modules(module, "autorig_addon.core.nn.layers")
+    assert {TRAINING_MODULE, TRAINING_MODULE + ".aggregation", "torch.nn"} <= names
+    names = imported_modules(module, "autorig_addon.core.nn.sub.layers")
+    assert "autorig_addon.core.nn.sub.training" in names
+
+
+def test_the_extension_leaves_the_training_package_out(tmp_path):
+    packaging.copy_addon_sources(str(tmp_path))
+    assert (tmp_path / "core" / "nn" / "graph.py").is_file()
+    assert (tmp_path / "core" / "nn" / "__init__.py").is_file()
+    assert not (tmp_path / "core" / "nn" / "training").exists()
+    shipped = {path.relative_to(tmp_path).as_posix() for path in tmp_path.rglob("*.py")}
+    sources = {path.relative_to(packaging.ADDON_DIR).as_posix() for path in packaging.ADDON_DIR.rglob("*.py")}
+    assert sources - shipped == {name for name in sources if name.startswith("core/nn/training/")}
+    assert not list(tmp_path.rglob("__pycache__"))
+
+
+def test_the_training_package_itself_imports_without_torch(repository_root):
+    # Listing the package (its __init__) must not load torch.
+    script = f"import json, sys, {TRAINING_MODULE}; print(json.dumps('torch' in sys.modules))"
+    result = subprocess.run([sys.executable, "-c", script], cwd=repository_root, capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout.strip().splitlines()[-1]) is False
 
 
 def test_command_line_help_imports_neither_bpy_nor_torch(repository_root):

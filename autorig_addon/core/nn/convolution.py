@@ -1,0 +1,75 @@
+"""Edge convolution in numpy: the message -> aggregate -> update layer the
+networks share.
+
+EdgeConv (Wang et al. 2019, the building block of RigNet's GMEdgeConv):
+every edge ``j -> i`` carries the message ``MLP([x_i, x_j - x_i])``, the
+receiver aggregates its messages (max by default), and the update keeps the
+aggregate as the node's new features. A node that receives no edge gets 0
+(see :mod:`.aggregation`). The inference twin of
+:class:`autorig_addon.core.nn.training.convolution.EdgeConv`; its weights
+are that module's ``state_dict`` under ``prefix`` (the MLP under
+``prefix + "mlp."``).
+
+The MLP's first layer is linear, so with its weight split as ``[A, B]``
+(columns for ``x_i`` and for ``x_j - x_i``) it equals
+``(A - B) x_i + B x_j + bias``: both terms are computed once per node and
+gathered per edge, instead of building the (e, 2c) message rows, which
+saves most of the layer's time (a mesh has ~10-40 times more edges than
+vertices).
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from .aggregation import AGGREGATIONS, gather
+from .layers import linear, mlp
+
+
+def edge_messages(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(e, 2c) rows ``[x_i, x_j - x_i]`` of every edge ``j -> i``, from
+    (n, c) node features and a (2, e) edge index (senders, receivers): the
+    EdgeConv MLP's input, written out (:func:`edge_convolution` does not
+    build it)."""
+    receivers = gather(x, edges[1])
+    return np.concatenate([receivers, gather(x, edges[0]) - receivers], axis=1)
+
+
+def first_layer_per_edge(x: np.ndarray, edges: np.ndarray, weight: np.ndarray,
+                         bias: Optional[np.ndarray]) -> np.ndarray:
+    """``linear(edge_messages(x, edges), weight, bias)`` computed per node
+    then gathered: (n, c), (2, e), (out, 2c), (out,) give (e, out)."""
+    channels = x.shape[1]
+    receiver_weight, difference_weight = weight[:, :channels], weight[:, channels:]
+    at_receiver = linear(x, receiver_weight - difference_weight, bias)
+    at_sender = linear(x, difference_weight)
+    return gather(at_receiver, edges[1]) + gather(at_sender, edges[0])
+
+
+def edge_convolution(x: np.ndarray, edges: np.ndarray, weights: dict, prefix: str, *, aggregation: str = "max",
+                     activation: str = "relu", norm: Optional[str] = None, activate_last: bool = True) -> np.ndarray:
+    """One EdgeConv layer.
+
+    Parameters
+    ----------
+    x : (n, c) float array, node features
+    edges : (2, e) int array, senders then receivers (:mod:`.graph`)
+    weights : dict of str -> array, holding the MLP ``prefix + "mlp."``
+        whose first layer takes ``2c`` inputs
+    prefix : str, the layer's name with its trailing dot (``"conv1."``)
+    aggregation : str, a key of :data:`.aggregation.AGGREGATIONS`
+    activation, norm, activate_last : the MLP's settings (:func:`.layers.mlp`)
+
+    Returns
+    -------
+    (n, out) float array, the aggregated messages of each node.
+    """
+    first = prefix + "mlp.linears.0."
+    if first + "weight" not in weights:
+        raise KeyError(f"No EdgeConv named {prefix!r} in the weights (no {first}weight).")
+    hidden = first_layer_per_edge(x, edges, weights[first + "weight"], weights.get(first + "bias"))
+    messages = mlp(hidden, weights, prefix + "mlp.", activation=activation, norm=norm, activate_last=activate_last,
+                   first_linear_applied=True)
+    return AGGREGATIONS[aggregation](messages, edges[1], len(x))

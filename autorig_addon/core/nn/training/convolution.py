@@ -1,0 +1,57 @@
+"""Edge convolution in torch: the training twin of
+:mod:`autorig_addon.core.nn.convolution` (message ``MLP([x_i, x_j - x_i])``
+on every edge ``j -> i``, aggregated at the receiver, max by default; the
+MLP's first linear layer computed per node and gathered, as there).
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from .aggregation import AGGREGATIONS, gather
+from .layers import MLP
+
+
+def edge_messages(x: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
+    """(e, 2c) rows ``[x_i, x_j - x_i]`` of every edge ``j -> i``."""
+    receivers = gather(x, edges[1])
+    return torch.cat([receivers, gather(x, edges[0]) - receivers], dim=1)
+
+
+def first_layer_per_edge(x: torch.Tensor, edges: torch.Tensor, weight: torch.Tensor,
+                         bias: Optional[torch.Tensor]) -> torch.Tensor:
+    """``F.linear(edge_messages(x, edges), weight, bias)`` computed per node
+    then gathered: (n, c), (2, e), (out, 2c), (out,) give (e, out)."""
+    channels = x.shape[1]
+    receiver_weight, difference_weight = weight[:, :channels], weight[:, channels:]
+    at_receiver = F.linear(x, receiver_weight - difference_weight, bias)
+    at_sender = F.linear(x, difference_weight)
+    return gather(at_receiver, edges[1]) + gather(at_sender, edges[0])
+
+
+class EdgeConv(nn.Module):
+    """One EdgeConv layer; its ``state_dict`` holds the MLP under ``mlp.``.
+
+    Parameters
+    ----------
+    in_channels : int, node feature width ``c`` (the MLP takes ``2c``)
+    channels : sequence of int, the MLP's widths after its input
+    aggregation : str, a key of :data:`.aggregation.AGGREGATIONS`
+    activation, norm, activate_last : the MLP's settings (:class:`.layers.MLP`)
+    """
+
+    def __init__(self, in_channels: int, channels: Sequence[int], *, aggregation: str = "max",
+                 activation: str = "relu", norm: Optional[str] = None, activate_last: bool = True):
+        super().__init__()
+        self.aggregate = AGGREGATIONS[aggregation]
+        self.mlp = MLP([2 * in_channels, *channels], activation=activation, norm=norm, activate_last=activate_last)
+
+    def forward(self, x: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
+        """(n, c) features and a (2, e) int64 edge index give (n, out)."""
+        first = self.mlp.linears[0]
+        hidden = first_layer_per_edge(x, edges, first.weight, first.bias)
+        return self.aggregate(self.mlp(hidden, first_linear_applied=True), edges[1], x.shape[0])

@@ -1,0 +1,112 @@
+"""Network weight files: a flat ``{name: array}`` dict in a compressed ``.npz``.
+
+The names are the torch ``state_dict`` keys of the trained module
+(:func:`autorig_addon.core.nn.training.export.module_weights` writes them),
+so the numpy forward pass reads the names the torch module wrote. Two
+reserved entries travel with the arrays: the file format version
+(:data:`WEIGHTS_FORMAT_VERSION`) and a JSON metadata dict (the network's
+name and the settings needed to rebuild it, the training run). The file is
+written to a temporary name and then renamed, so a failed save never
+leaves a half-written file under the final name. Numpy only: Blender loads
+these.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import zipfile
+from typing import NamedTuple, Optional
+
+import numpy as np
+
+from ..errors import InputError
+
+#: Version of the file layout; raise it when the layout changes, and make
+#: :func:`load_weights` read the old versions it still accepts.
+WEIGHTS_FORMAT_VERSION = 1
+#: Reserved array names (a double underscore starts no ``state_dict`` key).
+FORMAT_VERSION_KEY = "__format_version__"
+METADATA_KEY = "__metadata__"
+
+
+class LoadedWeights(NamedTuple):
+    """A weights file's contents: ``weights`` (name -> array) and
+    ``metadata`` (the JSON dict saved with them, ``{}`` when none)."""
+
+    weights: dict
+    metadata: dict
+
+
+def save_weights(path: str, weights: dict, metadata: Optional[dict] = None) -> None:
+    """Write ``weights`` (and ``metadata``) to ``path``.
+
+    Parameters
+    ----------
+    path : str
+        Destination, conventionally ``NAME.npz`` (used as given).
+    weights : dict of str -> array
+        Numeric or boolean arrays; names must not start with ``__``.
+    metadata : dict, optional
+        JSON-serialisable settings saved beside the arrays.
+
+    Raises
+    ------
+    ValueError
+        A reserved or non-string name, or a non-numeric array.
+    TypeError
+        Metadata that JSON cannot hold. (Both are programming errors;
+        nothing is written.)
+    """
+    arrays = {}
+    for name, value in weights.items():
+        if not isinstance(name, str) or not name or name.startswith("__") or "/" in name:
+            raise ValueError(f"Invalid weight name {name!r}: a non-empty string without '/' not starting with '__'.")
+        array = np.asarray(value)
+        if array.dtype.kind not in "biuf":
+            raise ValueError(f"Weight {name!r} has dtype {array.dtype}; only numeric arrays are saved.")
+        arrays[name] = array
+    arrays[FORMAT_VERSION_KEY] = np.asarray(WEIGHTS_FORMAT_VERSION, dtype=np.int64)
+    arrays[METADATA_KEY] = np.asarray(json.dumps(metadata or {}, sort_keys=True))
+    folder = os.path.dirname(os.path.abspath(path))
+    handle, temporary = tempfile.mkstemp(prefix=".weights_", suffix=".npz", dir=folder)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            np.savez_compressed(stream, **arrays)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
+
+
+def load_weights(path: str) -> LoadedWeights:
+    """Read a file written by :func:`save_weights`.
+
+    Raises
+    ------
+    InputError
+        The file does not exist, is not a weights file, or has a format
+        version this add-on does not read; the message names the file.
+    """
+    if not os.path.isfile(path):
+        raise InputError(f"Network weights file {path} does not exist.")
+    try:
+        archive = np.load(path, allow_pickle=False)
+        if not isinstance(archive, np.lib.npyio.NpzFile):  # a plain .npy array
+            raise ValueError("a single array, not an .npz archive")
+        with archive:
+            arrays = {name: archive[name] for name in archive.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
+        raise InputError(f"{path} is not a network weights file ({error}).") from None
+    if FORMAT_VERSION_KEY not in arrays or METADATA_KEY not in arrays:
+        raise InputError(f"{path} is not a network weights file (no format version or metadata entry).")
+    version = int(arrays.pop(FORMAT_VERSION_KEY))
+    if version != WEIGHTS_FORMAT_VERSION:
+        raise InputError(
+            f"{path} holds weights in format {version}, but this add-on reads format {WEIGHTS_FORMAT_VERSION}; "
+            "use weights trained for this version of the add-on."
+        )
+    metadata = json.loads(str(arrays.pop(METADATA_KEY)))
+    return LoadedWeights(arrays, metadata)
