@@ -226,3 +226,41 @@ class RecordingWorkspace:
 
     def status_text_set(self, text):
         self.texts.append(text)
+
+
+def parent_to_bone(obj, armature, bone_name: str) -> None:
+    """Parent ``obj`` to one bone as a user does: the object selected, the
+    armature active in Pose Mode with the bone active, Ctrl+P > Bone."""
+    select_only([obj, armature], active=armature)
+    bpy.ops.object.mode_set(mode="POSE")
+    armature.data.bones.active = armature.data.bones[bone_name]
+    bpy.ops.object.parent_set(type="BONE", keep_transform=True)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.context.view_layer.update()
+
+
+def pose_bone_turned(armature, bone_name: str, degrees: float, axis: str = "X") -> None:
+    """Turn one pose bone by ``degrees`` about its own ``axis`` (all others at rest)."""
+    from mathutils import Quaternion, Vector
+
+    for pose_bone in armature.pose.bones:
+        pose_bone.rotation_mode = "QUATERNION"
+        pose_bone.rotation_quaternion = (1.0, 0.0, 0.0, 0.0)
+    axis_vector = Vector({"X": (1, 0, 0), "Y": (0, 1, 0), "Z": (0, 0, 1)}[axis])
+    armature.pose.bones[bone_name].rotation_quaternion = Quaternion(axis_vector, np.radians(degrees))
+    bpy.context.view_layer.update()
+
+
+def evaluated_world_vertices(obj) -> np.ndarray:
+    """(n, 3) world positions of ``obj``'s vertices after its modifiers and parents."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        values = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", values)
+        matrix = np.array(evaluated.matrix_world)
+    finally:
+        evaluated.to_mesh_clear()
+    points = values.reshape(-1, 3).astype(np.float64)
+    return points @ matrix[:3, :3].T + matrix[:3, 3]

@@ -3,6 +3,7 @@
 import numpy as np
 
 from autorig_addon.core.distances.grid import VoxelGrid
+from autorig_addon.core.geometry.subdivision import subdivide_midpoints
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 
 
@@ -41,6 +42,15 @@ def cylinder(radius: float = 0.1, height: float = 1.0, segments: int = 24, rings
     if flip:
         F = F[:, ::-1]
     return Mesh(V, F)
+
+
+def subdivided(mesh: Mesh, times: int) -> Mesh:
+    """``mesh`` with every triangle split in four ``times`` times (same
+    shape, about four times the vertices each time), one object."""
+    vertices, triangles = mesh.vertices, mesh.triangles
+    for _ in range(times):
+        vertices, triangles, _ = subdivide_midpoints(vertices, triangles, np.zeros((len(vertices), 0)))
+    return Mesh(vertices, triangles, object_names=mesh.object_names[:1])
 
 
 def two_bone_skeleton(height: float = 1.0) -> Skeleton:

@@ -3,6 +3,7 @@
 import io
 import json
 import math
+import re
 import subprocess
 import sys
 
@@ -41,10 +42,11 @@ TRANSFER_ARGUMENTS = ["--source", "Body", "--out", "o.blend"]
 SKIN_ARGUMENTS = ["--out", "o.blend"]
 
 
-def save_rig_blend(path, sleeve_offset=(0.0, 0.0, 0.0)):
+def save_rig_blend(path, sleeve_offset=(0.0, 0.0, 0.0), sleeve_scale=1.0):
     reset_scene()
     rig = build_rig_scene()
     rig.sleeve.location = sleeve_offset
+    rig.sleeve.scale = (sleeve_scale,) * 3
     bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
     return local_positions(rig.sleeve)
 
@@ -118,6 +120,10 @@ def test_arguments_from_sys_argv(argv, expected):
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--mix", "1.5"], "error: argument --mix: 1.5 is not between 0 and 1"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--smoothing-iterations", str(MAX_SMOOTHING_ITERATIONS + 1)],
          f"error: argument --smoothing-iterations: {MAX_SMOOTHING_ITERATIONS + 1} is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--smoothing-iterations", "1000000"],
+         f"error: argument --smoothing-iterations: 1000000 is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--smoothing-iterations", "1000000"],
+         f"error: argument --smoothing-iterations: 1000000 is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-influences", "-1"],
          f"error: argument --max-influences: -1 is not between 0 and {MAX_INFLUENCES}"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-normal-angle", "181"],
@@ -182,6 +188,9 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     assert (transfer.accept_flipped_normals, transfer.smoothing_iterations, transfer.max_influences, transfer.mask_group) == (
         settings.accept_flipped_normals, settings.smoothing_iterations, settings.max_influences, settings.mask_group)
     assert transfer.smoothing_strength == pytest.approx(settings.smoothing_strength)
+    assert transfer.allow_poor_match == settings.allow_poor_match == transfer_options.DEFAULT_ALLOW_POOR_MATCH
+    assert cli_transfer.transfer_settings(parse(["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--allow-poor-match"])
+                                          ).options.allow_poor_match is True
     skin = parse(["skin", "in.blend", *SKIN_ARGUMENTS])
     assert (skin.distance.upper(), skin.resolution, skin.max_influences, skin.smoothing_iterations) == (
         settings.skin_distance, settings.skin_resolution, settings.skin_max_influences, settings.skin_smoothing_iterations)
@@ -422,3 +431,67 @@ def test_scene_io_fbx_round_trip_and_obj_import(clean_scene, tmp_path):
     assert len(meshes) == 1 and len(meshes[0].data.vertices) == 3
     with pytest.raises(InputError, match=f"No object named 'Body'. Available: {meshes[0].name}"):
         scene_io.find_object("Body")
+
+
+# --------------------------------------------------------------------------- bad input reported early and plainly
+
+
+@pytest.mark.parametrize("out, message", [
+    ("weighted.xyz", "--out {out!r}: cannot write '.xyz' files; use one of .blend, .glb, .gltf, .fbx, or a folder."),
+    ("weighted.obj", "--out {out!r}: cannot write '.obj' files; use one of .blend, .glb, .gltf, .fbx, or a folder."),
+    ("scene.blend/weighted.blend", "--out: {scene!r} is a file, not a folder; nothing can be written inside it."),
+])
+def test_a_bad_out_is_a_usage_error_before_anything_is_loaded(clean_scene, tmp_path, capsys, monkeypatch, out, message):
+    from autorig_addon.blender import scene_io
+
+    scene = str(tmp_path / "scene.blend")
+    save_rig_blend(scene)
+
+    def never(path):
+        raise AssertionError(f"{path} was loaded")
+
+    monkeypatch.setattr(scene_io, "load_scene", never)
+    expected = message.format(out=str(tmp_path / out), scene=scene)
+    for subcommand, arguments in (("transfer", ["--source", "Body"]), ("skin", [])):
+        code, stdout, err = run_main([subcommand, scene, *arguments, "--out", str(tmp_path / out), "--quiet"], capsys)
+        assert (code, stdout, err) == (2, "", f"error: {expected}\n")
+
+
+def test_a_garment_in_other_units_fails_with_the_factor_unless_allowed(clean_scene, tmp_path, capsys):
+    save_rig_blend(tmp_path / "inches.blend", sleeve_scale=2.54)
+    arguments = ["transfer", str(tmp_path / "inches.blend"), "--source", "Body", "--target", "Sleeve", "--quiet"]
+    code, out, _ = run_main([*arguments, "--out", str(tmp_path / "refused.blend")], capsys)
+    assert code == 1
+    (failed,) = json.loads(out)["failed"]
+    assert "'Sleeve' looks 2.54 times too large for 'Body' (inches and centimetres mixed up?)" in failed["error"]
+    assert failed["error"].endswith("To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line).")
+    assert not (tmp_path / "refused.blend").exists()
+    code, out, _ = run_main([*arguments, "--out", str(tmp_path / "allowed.blend"), "--allow-poor-match"], capsys)
+    assert code == 0
+    weights = convert.read_weights(open_blend(tmp_path / "allowed.blend")["Sleeve"], BONES).matrix
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)
+
+
+def test_skin_at_a_resolution_beyond_the_free_memory_fails_naming_one_that_fits(clean_scene, tmp_path, capsys,
+                                                                              monkeypatch):
+    from autorig_addon.core import memory
+
+    save_rig_blend(tmp_path / "scene.blend")
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 2**30)  # a machine with 1 GiB free
+    code, out, _ = run_main(["skin", str(tmp_path / "scene.blend"), "--mesh", "Body", "--resolution", "1024",
+                             "--out", str(tmp_path / "o.blend"), "--quiet"], capsys)
+    assert code == 1
+    (failed,) = json.loads(out)["failed"]
+    assert re.match(r"^The voxel grid at resolution 1024 \(\d+ x \d+ x \d+ cells\) would need about [\d.]+ GiB of "
+                    r"memory, but only 1 GiB is free\. Resolution \d+ fits: lower it to that or less \(Resolution in "
+                    r"the Skin panel, --resolution on the command line\)\.$", failed["error"]), failed["error"]
+    assert not (tmp_path / "o.blend").exists()
+
+
+def test_eval_with_an_out_inside_a_file_is_a_usage_error_before_any_scoring(tmp_path, capsys):
+    blocker = tmp_path / "report.json"
+    blocker.write_text("{}")
+    code, out, err = run_main(["eval", "skin", str(tmp_path), "--method", "nearest_bone",
+                               "--out", str(blocker / "again.json")], capsys)
+    assert (code, out) == (2, "")
+    assert err == f"error: --out: {str(blocker)!r} is a file, not a folder; nothing can be written inside it.\n"

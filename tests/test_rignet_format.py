@@ -201,3 +201,68 @@ def test_write_rejects_what_the_format_cannot_hold():
         rignet_rig_text(chain, Weights(np.ones((1, 1)), ("z",)))
     with pytest.raises(InputError, match=re.escape("Weights contain NaN or infinite values; clean them before writing.")):
         rignet_rig_text(chain, Weights(np.array([[np.nan, 1.0]]), ("a", "b")))
+
+
+# --------------------------------------------------------------------------- files that are not rigs, or damaged ones
+
+
+def test_a_glb_picked_by_mistake_is_named_as_such(tmp_path):
+    path = tmp_path / "character.glb"
+    path.write_bytes(b"glTF\x02\x00\x00\x00\x9c\x12\x00\x00JSON{}")  # the header every .glb starts with
+    with pytest.raises(InputError, match=re.escape(
+            "'character.glb' is a binary glTF file, not a RigNet rig: import it with File > Import > glTF 2.0.")):
+        read_rignet_rig(path)
+
+
+def test_a_file_that_is_not_utf8_text_is_refused_not_a_decode_error(tmp_path):
+    path = tmp_path / "rig.txt"
+    path.write_bytes("joints épaule 0 0 0\nroot épaule\n".encode("latin-1"))  # saved in a Windows code page
+    with pytest.raises(InputError, match=re.escape(
+            "'rig.txt' is not a RigNet rig: it is not text (byte 0xe9 at position 7 is not UTF-8).")):
+        read_rignet_rig(path)
+
+
+def test_a_huge_vertex_index_is_refused_before_any_allocation():
+    text = "joints a 0 0 0\njoints b 0 0 1\nroot a\nhier a b\nskin 0 a 1.0\nskin 1000000000000 b 1.0\n"
+    with pytest.raises(InputError, match=re.escape(
+            "Line 6: vertex index 1000000000000 is larger than any mesh can have "
+            "(Blender meshes hold at most 2147483647 vertices); the file is damaged.")):
+        read_rignet_rig(text)
+
+
+def test_a_weight_table_larger_than_the_free_memory_is_refused(monkeypatch):
+    from autorig_addon.core import memory
+
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 2 ** 30)  # a machine with 1 GiB free
+    text = "joints a 0 0 0\njoints b 0 0 1\nroot a\nhier a b\nskin 0 a 1.0\nskin 2000000000 b 1.0\n"
+    with pytest.raises(InputError, match=re.escape(
+            "Line 6: vertex index 2000000000 means a mesh of 2000000001 vertices; its weight table would need "
+            "about 29.8 GiB of memory, but only 1 GiB is free. The file is damaged, or import it with its mesh "
+            "selected so the indices are checked against it.")):
+        read_rignet_rig(text)
+    # Checked against a mesh, the same line is out of range.
+    with pytest.raises(InputError, match="Line 6: vertex index 2000000000 is out of range for a mesh of 10 vertices"):
+        read_rignet_rig(text, vertex_count=10)
+
+
+@pytest.mark.parametrize("coordinates", ["0 0 1e30", "-2e6 0 0"])
+def test_joints_far_beyond_any_character_are_refused(coordinates):
+    text = f"joints a 0 0 0\njoints b {coordinates}\nroot a\nhier a b\n"
+    with pytest.raises(InputError, match=r"^Line 2: joint 'b' lies at .*, beyond 1e\+06 units from the origin: "
+                                         r"Blender cannot keep bone lengths there\."):
+        read_rignet_rig(text)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("joints a 0 0 0\njoints b 0 0 0\njoints c 0 0 1\nroot a\nhier a b\nhier b c\n",
+     "Line 2: joint 'b' is at the same position as its parent 'a' (line 1)"),
+    ("joints a 0 0 0\njoints b 0 0 1\njoints c 0 0 1\nroot a\nhier a b\nhier b c\n",
+     "Line 3: joint 'c' is at the same position as its parent 'b' (line 2)"),
+    ("joints a 1 1 1\njoints b 1 1 1\nroot a\nhier a b\n",
+     "Line 2: joint 'b' is at the same position as its parent 'a' (line 1)"),
+])
+def test_a_joint_at_its_parents_position_is_refused(text, message):
+    with pytest.raises(InputError, match="^" + re.escape(
+            f"{message}, so the bone between them has no length or direction (1 such joint(s)). Move one of them, "
+            "or remove the duplicate and give its children to the other.") + "$"):
+        read_rignet_rig(text)

@@ -98,22 +98,72 @@ def test_import_with_wrong_vertex_count_leaves_the_scene_unchanged(clean_scene, 
     assert len(small.vertex_groups) == 0
 
 
-def test_import_onto_a_mesh_with_more_vertices_than_the_file_is_refused(clean_scene, tmp_path):
+def test_import_onto_a_mesh_the_file_leaves_mostly_unweighted_is_refused(clean_scene, tmp_path):
     import bpy
 
     from blender_fixtures import mesh_object
 
     path = tmp_path / "rig.txt"
-    path.write_text(TWO_JOINT_RIG)
-    bigger = mesh_object("Bigger", [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+    path.write_text(TWO_JOINT_RIG)  # weights vertices 0 to 2
+    grid = [[x, y, 0] for y in range(3) for x in range(3)]
+    bigger = mesh_object("Bigger", grid, [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
     bpy.context.view_layer.update()
     select_only([bigger], active=bigger)
-    before = sorted(o.name for o in bpy.data.objects)
+    before = scene_state([bigger])
     with pytest.raises(RuntimeError, match=re.escape(
-            "The file weights vertices up to 2, but 'Bigger' has 4 vertices: it is not the mesh the rig was made for.")):
+            "The file weights 3 of the 9 vertices of 'Bigger' and leaves the rest without weight: "
+            "it is not the mesh the rig was made for.")):
         bpy.ops.autorig.import_rignet(filepath=str(path))
-    assert sorted(o.name for o in bpy.data.objects) == before
-    assert len(bigger.vertex_groups) == 0
+    assert scene_state([bigger]) == before
+
+
+def test_export_of_a_mesh_whose_last_vertex_is_unweighted_imports_back_onto_it(clean_scene, tmp_path, capfd):
+    import bpy
+
+    scene = build_rig_scene(with_button=False)
+    body = scene.body
+    last = len(body.data.vertices) - 1  # the top cap's centre
+    for group in body.vertex_groups:
+        group.remove([last])  # legal: a vertex may have no weight, and then has no 'skin' line
+    names = (LOWER_BONE, UPPER_BONE)
+    exported = group_weights(body, names)
+    assert not exported[last].any() and exported[:last].sum(axis=1).min() > 0.99
+    path = tmp_path / "rig.txt"
+    select_only([body], active=body)
+    assert bpy.ops.autorig.export_rignet(filepath=str(path)) == {"FINISHED"}
+    assert f"skin {last - 1} " in path.read_text() and f"skin {last} " not in path.read_text()
+
+    assert bpy.ops.autorig.import_rignet(filepath=str(path)) == {"FINISHED"}
+    imported = bpy.data.objects["rig"]
+    np.testing.assert_allclose(group_weights(body, names), exported, atol=1e-6)
+    assert [m.object for m in body.modifiers if m.type == "ARMATURE"] == [imported]
+    assert ("Imported 'rig' with 2 bones, 'Body' bound (1 of its vertices have no weight in the file and stay "
+            "in place when posed).") in capfd.readouterr().out
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"glTF\x02\x00\x00\x00", "'picked.txt' is a binary glTF file, not a RigNet rig: import it with File > Import > glTF 2.0."),
+    (b"\x89PNG\r\n\x1a\n", "'picked.txt' is not a RigNet rig: it is not text (byte 0x89 at position 0 is not UTF-8)."),
+    (b"joints a 0 0 0\njoints b 0 0 1e30\nroot a\nhier a b\n", "Line 2: joint 'b' lies at 0, 0, 1e+30, beyond 1e+06"),
+    (b"joints a 0 0 0\njoints b 0 0 0\nroot a\nhier a b\n", "Line 2: joint 'b' is at the same position as its parent 'a'"),
+    (b"joints a 0 0 0\njoints b 0 0 1\nroot a\nhier a b\nskin 1000000000000 a 1\n",
+     "Line 5: vertex index 1000000000000 is larger than any mesh can have"),
+])
+def test_import_of_a_wrong_or_damaged_file_reports_why_and_changes_nothing(clean_scene, tmp_path, content, message):
+    import bpy
+
+    from blender_fixtures import mesh_object
+
+    path = tmp_path / "picked.txt"
+    path.write_bytes(content)
+    mesh = mesh_object("Triangle", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    bpy.context.view_layer.update()
+    for active in (mesh, None):
+        select_only([mesh] if active else [], active=active)
+        before = scene_state([mesh])
+        with pytest.raises(RuntimeError, match=re.escape(message)):
+            bpy.ops.autorig.import_rignet(filepath=str(path))
+        assert scene_state([mesh]) == before and len(bpy.data.armatures) == 0
 
 
 def test_import_that_fails_while_writing_leaves_neither_armature_nor_groups(clean_scene, tmp_path, monkeypatch):

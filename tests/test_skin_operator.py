@@ -19,6 +19,7 @@ from blender_fixtures import (
     RecordingWorkspace,
     cylinder_geometry,
     group_weights,
+    local_positions,
     make_armature,
     mesh_object,
     scene_state,
@@ -271,3 +272,106 @@ def test_modal_shows_progress_then_ends_through_the_same_cleanup_on_esc():
     assert context.window_manager.calls[-2:] == [("remove_timer", "timer"), ("end",)]
     assert context.workspace.texts[-1] is None
     assert operator.reports == [({"WARNING"}, "Skinning cancelled; nothing was changed.")]
+
+
+# --------------------------------------------------------------------------- strays, non-finite positions, modes
+
+#: Where the stray vertex lands: 10 km off the character.
+FAR_AWAY = (10000.0, 0.0, 1.0)
+
+
+def skinned_weights(armature, tube):
+    import bpy
+
+    select_only([armature, tube], active=armature)
+    assert bpy.ops.autorig.skin_weights(skin_resolution=40) == {"FINISHED"}
+    return group_weights(tube, [LOWER_BONE, UPPER_BONE])
+
+
+def tube_with_loose_vertex(name="Stray"):
+    """The tube plus one vertex in no face, far away (a vertex left behind in Edit Mode)."""
+    import bpy
+
+    vertices, faces = cylinder_geometry(BODY_RADIUS, 0.0, BODY_HEIGHT, 24, 20, capped=True)
+    obj = mesh_object(name, np.vstack([vertices, [FAR_AWAY]]), faces)
+    bpy.context.view_layer.update()
+    return obj
+
+
+def test_a_far_stray_vertex_leaves_the_other_weights_unchanged(clean_scene, capfd):
+    armature = make_armature()
+    clean = skinned_weights(armature, unbound_cylinder("Clean"))
+    stray = tube_with_loose_vertex()
+    capfd.readouterr()
+    weights = skinned_weights(armature, stray)
+    assert ("'Stray': 1 stray vertex far from the rest of the mesh left out of the distances and weighted like the "
+            "nearest kept vertex." in "".join(capfd.readouterr()))
+    np.testing.assert_allclose(weights[:-1], clean, atol=1e-9)
+    # The stray follows the nearest vertex of the tube: on the joint ring (z = 1), half on each bone.
+    nearest = np.argmin(np.linalg.norm(local_positions(stray)[:-1] - FAR_AWAY, axis=1))
+    assert local_positions(stray)[nearest].tolist() == pytest.approx([BODY_RADIUS, 0.0, 1.0])
+    np.testing.assert_array_equal(weights[-1], weights[nearest])
+    np.testing.assert_allclose(weights[-1], [0.5, 0.5], atol=1e-6)
+
+
+def test_a_vertex_dragged_far_away_leaves_the_other_weights_almost_unchanged(clean_scene):
+    import bpy
+
+    armature = make_armature()
+    clean = skinned_weights(armature, unbound_cylinder("Clean"))
+    dragged = unbound_cylinder("Dragged")
+    top_centre = len(dragged.data.vertices) - 1
+    dragged.data.vertices[top_centre].co = (0.0, 0.0, 10000.0)
+    bpy.context.view_layer.update()
+    weights = skinned_weights(armature, dragged)
+    # Its cap triangles go with it, so the rest differs only near the top, and by little.
+    np.testing.assert_allclose(weights[:top_centre], clean[:top_centre], atol=1e-3)
+    # It follows rigidly one vertex of the top ring it is joined to.
+    top_ring = np.arange(20 * 24, 21 * 24)
+    assert any(np.array_equal(weights[top_centre], weights[index]) for index in top_ring)
+    assert weights[top_centre, 1] > 0.99
+
+
+@pytest.mark.parametrize("value", [float("inf"), float("nan")])
+def test_non_finite_vertex_is_refused_naming_the_object(armature_and_tube, value):
+    import bpy
+
+    armature, tube = armature_and_tube
+    tube.data.vertices[5].co.x = value  # Blender stores inf as the float32 maximum
+    bpy.context.view_layer.update()
+    before = scene_state([armature, tube])
+    message = ("'Tube' has a vertex at an infinite or undefined (NaN) position (index 5): move or delete it in Edit "
+               "Mode first.")
+    with pytest.raises(RuntimeError, match=f"^Error: {re.escape(message)}\n$"):
+        bpy.ops.autorig.skin_weights(skin_resolution=32)
+    assert scene_state([armature, tube]) == before
+
+
+def test_skinning_works_in_weight_paint_and_pose_mode_and_says_why_not_in_edit_mode(armature_and_tube):
+    import bpy
+
+    armature, tube = armature_and_tube
+    # Weight Paint Mode on the mesh, the armature selected (how riggers paint).
+    select_only([armature, tube], active=tube)
+    bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
+    assert bpy.ops.autorig.skin_weights(skin_resolution=32) == {"FINISHED"}
+    assert tube.mode == "WEIGHT_PAINT"
+    in_weight_paint = group_weights(tube, [LOWER_BONE, UPPER_BONE])
+    bpy.ops.object.mode_set(mode="OBJECT")
+    # Pose Mode on the armature, posed: the rest shape is what is weighted.
+    select_only([armature, tube], active=armature)
+    bpy.ops.object.mode_set(mode="POSE")
+    armature.pose.bones[UPPER_BONE].rotation_quaternion = (0.7071068, 0.7071068, 0.0, 0.0)
+    assert bpy.ops.autorig.skin_weights(skin_resolution=32) == {"FINISHED"}
+    np.testing.assert_allclose(group_weights(tube, [LOWER_BONE, UPPER_BONE]), in_weight_paint, atol=1e-6)
+    z = np.array([v.co.z for v in tube.data.vertices])
+    assert in_weight_paint[z < 0.3, 0].min() > 0.9 and in_weight_paint[z > 1.7, 1].min() > 0.9
+    bpy.ops.object.mode_set(mode="OBJECT")
+    # Edit Mode: unavailable, with the reason.
+    select_only([armature, tube], active=tube)
+    bpy.ops.object.mode_set(mode="EDIT")
+    with pytest.raises(RuntimeError, match=re.escape(
+            "Operator bpy.ops.autorig.skin_weights.poll() Skin Weights needs Object, Pose or Weight Paint Mode: "
+            "leave Edit Mode first")):
+        bpy.ops.autorig.skin_weights()
+    bpy.ops.object.mode_set(mode="OBJECT")

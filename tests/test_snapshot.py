@@ -24,7 +24,7 @@ def test_restored_on_failure_undoes_a_half_done_write(clean_scene, monkeypatch):
     sleeve.vertex_groups.new(name="Pin").add([1], 1.0, "REPLACE")
     before = group_weights(sleeve, [UPPER_BONE, "Pin", LOWER_BONE])
 
-    def broken_binding(obj, armature_obj):
+    def broken_binding(obj, armature_obj, world=None):
         obj.modifiers.new("Half", "ARMATURE")
         raise RuntimeError("disk full")
 

@@ -54,9 +54,11 @@ def test_inner_layer_with_flipped_normals_needs_the_second_pass(body):
     result = transfer_weights(source, weights, target)
     assert np.all(result.status == VertexStatus.COPIED_FLIPPED)
     np.testing.assert_allclose(result.weights.matrix[:, 1], expected_upper(target.vertices[:, 2]), atol=1e-12)
-    message = (f"No vertex of 'mesh' lies within {result.max_distance:.4g} of the source surface with agreeing "
-               "normals: are the objects far apart or at different scales? Apply their transforms or raise the "
-               "match distance.")
+    message = (f"No vertex of 'mesh' lies within {result.max_distance:.4g} of 'mesh' with agreeing normals on "
+               f"weighted parts. {target.vertex_count} of its vertices lie that near but their normals differ from "
+               "the body's by more than 30 degrees: recalculate the normals (Shift+N), turn on Flipped Normals or "
+               "raise the normal angle. To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the "
+               "command line).")
     with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
         transfer_weights(source, weights, target, TransferOptions(accept_flipped_normals=False))
 
@@ -175,9 +177,11 @@ def test_far_apart_or_rescaled_targets_are_refused(body):
         transfer_weights(source, weights, moved)
     scaled = Mesh(target.vertices * 100.0, target.triangles)
     ratio = scaled.bounding_box_diagonal / source.bounding_box_diagonal
-    assert round(ratio) == 92
-    message = ("The target is 92 times larger than the source: the objects look like they are at different scales. "
-               "Apply their scale (Ctrl+A) or fix the units.")
+    assert f"{ratio:.3g}" == "91.6"
+    message = ("The target 'mesh' is 91.6 times larger than the source 'mesh': they look like they are at "
+               "different scales. 'mesh' looks 100 times too large for 'mesh' (centimetres and metres mixed up?): "
+               "scaled by 1/100, 100% of it would match the body. Fix the units or the object scale, then apply "
+               "it (Ctrl+A).")
     with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
         transfer_weights(source, weights, scaled)
 
@@ -205,10 +209,12 @@ def test_unusable_inputs_are_refused_with_their_message(body):
     for arguments, keywords, message in cases:
         with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
             transfer_weights(*arguments, **keywords)
-    bad = weights.matrix.copy()
-    bad[0, 0] = np.nan
-    with pytest.raises(InputError, match="NaN"):
-        transfer_weights(source, Weights(bad, weights.bone_names), target)
+    corrupt = Weights(np.full_like(weights.matrix, np.nan), weights.bone_names)
+    message = (f"The source 'mesh' has no usable weights: {source.vertex_count} of its {source.vertex_count} "
+               "vertices have NaN, infinite or negative weights and the others none. Clean the weights "
+               "(Weights > Clean) or skin the body again.")
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
+        transfer_weights(source, corrupt, target)
 
 
 def test_inpainting_reproduces_linear_function_on_a_flat_grid():
@@ -284,3 +290,154 @@ def test_matching_copies_near_points_and_flags_opposite_normals():
     strict = match_closest_points(square, source_weights, target, normals, 0.2, 30.0, False)
     np.testing.assert_array_equal(strict.matched, [True, False, False, False])
     assert not strict.flipped.any()
+
+
+# --------------------------------------------------------------------------- bad source weights and poor matches
+
+
+def body_painted_below(body, z_limit, value):
+    """The body's weights with every vertex above ``z_limit`` set to
+    ``value`` (0: never painted; NaN, inf or negative: corrupt), as an
+    artist leaving the top of the body unpainted would."""
+    source, weights = body
+    matrix = weights.matrix.copy()
+    matrix[source.vertices[:, 2] > z_limit, 0] = value
+    if value == 0.0:
+        matrix[source.vertices[:, 2] > z_limit] = 0.0
+    return Weights(matrix, weights.bone_names)
+
+
+@pytest.mark.parametrize("value", [0.0, np.nan, np.inf, -1.0])
+def test_unweighted_or_corrupt_body_rows_never_count_as_a_match(body, value):
+    source, _ = body
+    painted = body_painted_below(body, 0.71, value)  # body rings from z = 0.725 up carry no usable weight
+    target = sleeve()  # rings every 0.03 from z = 0.05
+    result = transfer_weights(source, painted, target)
+    z = target.vertices[:, 2]
+    over_unweighted = z > 0.7  # their closest points lie on (or draw from) the rings above 0.71
+    np.testing.assert_array_equal(result.status, np.where(over_unweighted, VertexStatus.INPAINTED, VertexStatus.COPIED))
+    # Inpainted from the copied rings below, which all have the upper bone alone.
+    np.testing.assert_allclose(result.weights.matrix[over_unweighted], [[0.0, 1.0]] * int(over_unweighted.sum()),
+                               atol=1e-12)
+    upper = expected_upper(z[~over_unweighted])
+    np.testing.assert_allclose(result.weights.matrix[~over_unweighted], np.column_stack([1 - upper, upper]), atol=1e-12)
+    unusable = int(np.count_nonzero(source.vertices[:, 2] > 0.71))
+    assert (result.unweighted_source_vertices, result.near_unweighted) == (unusable, int(over_unweighted.sum()))
+    corrupt = "" if value == 0.0 else f" ({unusable} with NaN, infinite or negative weights)"
+    copied, inpainted = target.vertex_count - int(over_unweighted.sum()), int(over_unweighted.sum())
+    assert (copied, inpainted) == (880, 360)
+    assert result.summary() == (
+        f"880 copied, 360 inpainted (29%), {unusable} vertices of 'mesh' have no "
+        f"usable weight{corrupt}; {int(over_unweighted.sum())} vertices near them were inpainted")
+
+
+def test_a_garment_mostly_over_an_unpainted_body_is_refused_unless_allowed(body):
+    source, _ = body
+    painted = body_painted_below(body, 0.11, 0.0)  # only the bottom of the body was painted
+    target = sleeve()
+    copied = int(np.count_nonzero(target.vertices[:, 2] < 0.1))
+    assert (copied, target.vertex_count) == (80, 1240)
+    distance = 0.05 * target.bounding_box_diagonal
+    message = (f"Only 6% of 'mesh' (80 of 1240 vertices) lies within {distance:.3g} of 'mesh' with "
+               "agreeing normals on weighted parts; the rest would be guessed by inpainting. "
+               f"{target.vertex_count - copied} of its vertices lie over parts of 'mesh' without usable weights: "
+               "weight those parts of the body first. To transfer anyway, turn on Allow Poor Match "
+               "(--allow-poor-match on the command line).")
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
+        transfer_weights(source, painted, target)
+    result = transfer_weights(source, painted, target, TransferOptions(allow_poor_match=True))
+    np.testing.assert_allclose(result.weights.matrix, [[1.0, 0.0]] * target.vertex_count, atol=1e-12)
+    only_above = body_painted_below(body, -1.0, 0.0)
+    with pytest.raises(InputError, match="^The source 'mesh' carries no bone weights to transfer.$"):
+        transfer_weights(source, only_above, target)
+
+
+@pytest.mark.parametrize("factor, pivot, words", [
+    (2.54, "origin", "looks 2.54 times too large for 'Body' (inches and centimetres mixed up?): scaled by 1/2.54"),
+    (1 / 2.54, "origin", "looks 2.54 times too small for 'Body' (inches and centimetres mixed up?): scaled by 2.54"),
+    (2.54, "centre", "looks 2.54 times too large for 'Body' (inches and centimetres mixed up?): scaled by 1/2.54"),
+    (1 / 100, "centre", "looks 100 times too small for 'Body' (centimetres and metres mixed up?): scaled by 100"),
+])
+def test_a_garment_at_another_unit_scale_is_refused_naming_the_factor(body, factor, pivot, words):
+    source, weights = body
+    source = Mesh(source.vertices, source.triangles, object_names=("Body",))
+    garment = sleeve()
+    centre = np.zeros(3) if pivot == "origin" else 0.5 * (garment.vertices.min(0) + garment.vertices.max(0))
+    scaled = Mesh(centre + factor * (garment.vertices - centre), garment.triangles, object_names=("Sleeve",))
+    with pytest.raises(InputError, match=re.escape(f"'Sleeve' {words}, 100% of it would match the body.")):
+        transfer_weights(source, weights, scaled)
+
+
+def test_a_garment_crossing_the_body_at_2_54_times_its_scale_is_refused_unless_allowed():
+    # A body with broad shoulders (a wide cylinder from z = 2 to 2.54 above a
+    # thin one) and a sleeve for its thin part modelled in inches: at 2.54
+    # times its size the sleeve still meets the shoulders, so a fifth of it
+    # copies weights there, and the rest would be guessed.
+    thin, broad = cylinder(radius=0.1, height=1.0, rings=41), cylinder(radius=0.254, height=0.54, z0=2.0, rings=23)
+    body = Mesh.concatenate([thin, broad])
+    body = Mesh(body.vertices, body.triangles, object_names=("Body",))
+    upper = (body.vertices[:, 2] > 1.5).astype(float)
+    weights = Weights(np.column_stack([1 - upper, upper]), ("lower", "upper"))
+    garment = sleeve()
+    inches = Mesh(2.54 * garment.vertices, garment.triangles, object_names=("Sleeve",))
+    with pytest.raises(InputError) as refused:
+        transfer_weights(body, weights, inches)
+    message = str(refused.value)
+    assert re.match(r"^Only 1\d% of 'Sleeve' \(\d+ of 1240 vertices\) lies within ", message), message
+    assert ("'Sleeve' looks 2.54 times too large for 'Body' (inches and centimetres mixed up?): scaled by 1/2.54, "
+            "100% of it would match the body. Fix the units or the object scale, then apply it (Ctrl+A). "
+            "To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line).") in message
+    allowed = transfer_weights(body, weights, inches, TransferOptions(allow_poor_match=True))
+    np.testing.assert_allclose(allowed.weights.matrix.sum(axis=1), 1.0, atol=1e-12)
+    fitted = transfer_weights(body, weights, Mesh(garment.vertices, garment.triangles))
+    assert np.all(fitted.status == VertexStatus.COPIED)
+
+
+def test_a_garment_matched_far_away_after_raising_the_distance_is_refused(body):
+    source, weights = body
+    target = sleeve()
+    far = Mesh(target.vertices + [100.0, 0.0, 0.0], target.triangles, object_names=("Sleeve",))
+    with pytest.raises(InputError) as refused:
+        transfer_weights(source, weights, far, TransferOptions(max_distance=200.0))
+    median = float(np.median(np.linalg.norm(far.vertices[:, :2], axis=1) - 0.1))
+    assert str(refused.value).startswith(
+        f"'Sleeve' would copy weights from points of 'mesh' {median:.3g} away (median), ")
+    assert ": it is not on the body (match distance 200). Move it onto the body or lower the match distance. " \
+           "To transfer anyway" in str(refused.value)
+
+
+def test_an_infinite_vertex_is_named_not_reported_as_a_scale(body):
+    source, weights = body
+    target = sleeve()
+    vertices = target.vertices.copy()
+    vertices[7] = [np.finfo(np.float32).max, 0.0, 0.0]  # how Blender stores a vertex moved to infinity
+    with pytest.raises(InputError, match=r"^'Sleeve' has a vertex at an infinite or undefined \(NaN\) position "
+                                         r"\(index 7\)"):
+        transfer_weights(source, weights, Mesh(vertices, target.triangles, object_names=("Sleeve",)))
+
+
+def test_protected_vertices_with_nothing_to_keep_are_transferred_not_left_empty(body):
+    source, weights = body
+    target = sleeve()
+    top = target.vertices[:, 2] > 0.9
+    existing = np.zeros((target.vertex_count, 2))
+    existing[top & (target.vertices[:, 0] > 0)] = [0.25, 0.75]  # half the protected ring was painted
+    result = transfer_weights(source, weights, target, protected=top, protected_weights=Weights(existing, ("upper", "lower")))
+    kept = top & (target.vertices[:, 0] > 0)
+    np.testing.assert_allclose(result.weights.matrix[kept], [[0.75, 0.25]] * int(kept.sum()), atol=1e-12)
+    np.testing.assert_allclose(result.weights.matrix[top & ~kept], [[0.0, 1.0]] * int((top & ~kept).sum()), atol=1e-12)
+    assert result.unprotected == int((top & ~kept).sum())
+    assert f"{result.unprotected} protected vertices had no weight to keep and were transferred" in result.summary()
+
+
+def test_matching_falls_back_to_the_nearest_weighted_vertex_where_the_closest_point_has_none():
+    square = grid(3, 3)  # vertices at x, y in {0, 0.5, 1}
+    source_weights = np.column_stack([1 - square.vertices[:, 0], square.vertices[:, 0]])
+    source_weights[square.vertices[:, 0] > 0.9] = np.nan  # the x = 1 column is corrupt
+    target = Mesh([[0.25, 0.5, 0.05], [0.9, 0.5, 0.05], [0.5, 0.4, 0.05]], [[0, 1, 2]])
+    normals = np.tile([0.0, 0.0, 1.0], (3, 1))
+    matches = match_closest_points(square, source_weights, target, normals, 0.2, 30.0, True)
+    np.testing.assert_array_equal(matches.matched, [True, False, True])
+    np.testing.assert_array_equal(matches.unweighted, [False, True, False])
+    # Vertex 1 draws on the corrupt column: it takes the nearest usable vertex's (x = 0.5) weights.
+    np.testing.assert_allclose(matches.weights, [[0.75, 0.25], [0.5, 0.5], [0.5, 0.5]], atol=1e-12)

@@ -15,7 +15,7 @@ from autorig_addon.blender import convert, status_attribute
 from autorig_addon.blender.operators import transfer as transfer_operators
 from autorig_addon.blender.operators.transfer import scene_defaults
 from autorig_addon.blender.ui.properties import TRANSFER_OPTION_NAMES
-from autorig_addon.core.errors import Cancelled
+from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.transfer.options import DEFAULT_MASK_GROUP
 from autorig_addon.core.transfer.transfer import VertexStatus
 from blender_fixtures import (
@@ -171,7 +171,8 @@ def test_objects_far_apart_are_refused(rig):
         ({"source": "Body", "targets": "Sleeve", "bones": "Spine"},
          "Spine: not deform bones of 'Armature'. Deform bones: Lower, Upper."),
         ({"source": "Body", "targets": ""},
-         "No target: select the meshes to weight together with the source, or pick a Target in the AutoRig panel."),
+         "No target: select the meshes to weight together with the source, or pass them by name "
+         "(bpy.ops.autorig.transfer_weights(targets='Shirt,Trousers', ...))."),
     ],
 )
 def test_bad_input_is_refused_with_its_reason(rig, arguments, message):
@@ -191,23 +192,34 @@ def test_source_without_bone_weights_is_refused(rig):
 def test_ambiguous_or_missing_source_is_refused(rig):
     select_only([], active=None)
     assert_refused_unchanged(
-        rig, "No source: pick the skinned body as Source in the AutoRig panel (or make it the active object).",
+        rig, "No source: make the skinned body the active object or pass it by name "
+        "(bpy.ops.autorig.transfer_weights(source='Body', ...)).",
     )
     bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve")
     select_only([rig.body, rig.sleeve], active=None)
     assert_refused_unchanged(
-        rig, "Several selected meshes are skinned (Body, Sleeve): make the body the active object or pick it as "
-        "Source in the AutoRig panel.",
+        rig, "Several selected meshes are skinned (Body, Sleeve): make the body the active object or pass it by "
+        "name (bpy.ops.autorig.transfer_weights(source='Body', ...)).",
     )
 
 
 def test_edit_mode_target_is_refused(rig):
     select_only([rig.sleeve], active=rig.sleeve)
     bpy.ops.object.mode_set(mode="EDIT")
-    assert_refused_unchanged(
-        rig, "'Sleeve' is in Edit Mode: switch to Object Mode so its edits are saved, then transfer.",
-        source="Body", targets="Sleeve",
-    )
+    before = scene_state([rig.body, rig.sleeve, rig.armature])
+    # The operator is unavailable, and Blender says why.
+    with pytest.raises(RuntimeError, match=re.escape(
+            "Operator bpy.ops.autorig.transfer_weights.poll() Transfer Weights needs Object, Pose or Weight Paint "
+            "Mode: leave Edit Mode first")):
+        bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve")
+    # Called from Python with another object active, the plan refuses the target by name.
+    bpy.context.view_layer.objects.active = rig.body
+    with pytest.raises(InputError, match=re.escape(
+            "'Sleeve' is in Edit Mode: switch to Object Mode so its edits are saved, then transfer.")):
+        transfer_operators.plan_transfer(rig.body, [rig.sleeve], transfer_operators.TransferSettings(),
+                                         bpy.context.evaluated_depsgraph_get())
+    bpy.context.view_layer.objects.active = rig.sleeve
+    assert scene_state([rig.body, rig.sleeve, rig.armature]) == before
     bpy.ops.object.mode_set(mode="OBJECT")
     assert len(rig.sleeve.vertex_groups) == 0
 
@@ -440,3 +452,68 @@ def test_skin_panel_draws_every_skin_setting_and_the_button(rig):
     assert {name for kind, name in log if kind == "prop"} == set(SKIN_OPTION_NAMES)
     assert ("operator", "autorig.skin_weights") in log
     assert ("label", f"Sleeve to {rig.armature.name}") in log
+
+
+# --------------------------------------------------------------------------- strays, non-finite positions, modes
+
+#: Where a stray vertex lands: 10 km off the character.
+FAR_AWAY = (10000.0, 0.0, 0.5)
+
+
+def add_loose_vertex(obj, position=FAR_AWAY):
+    """One more vertex in no face (a vertex left behind in Edit Mode)."""
+    obj.data.vertices.add(1)
+    obj.data.vertices[-1].co = position
+    obj.data.update()
+    bpy.context.view_layer.update()
+
+
+def test_a_stray_vertex_on_the_target_leaves_the_other_weights_unchanged(rig, capfd):
+    add_loose_vertex(rig.sleeve)
+    capfd.readouterr()
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
+    assert (f"Info: {SLEEVE_REPORT}; 1 stray vertex far from the rest of the mesh left out of the transfer and "
+            "weighted like the nearest kept vertex\n" in "".join(capfd.readouterr()))
+    weights = sleeve_weights(rig)
+    np.testing.assert_allclose(weights[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    # The stray follows its nearest sleeve vertex, at z = 0.5: all Lower.
+    np.testing.assert_allclose(weights[-1], [1.0, 0.0], atol=1e-6)
+    assert status_attribute.read_status_attribute(rig.sleeve)[-1] == VertexStatus.UNMATCHED_PART
+
+
+def test_a_stray_vertex_on_the_source_changes_nothing(rig, capfd):
+    add_loose_vertex(rig.body)
+    rig.body.vertex_groups[LOWER_BONE].add([len(rig.body.data.vertices) - 1], 1.0, "REPLACE")
+    capfd.readouterr()
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
+    assert (f"Info: {SLEEVE_REPORT}; source 'Body': 1 stray vertex far from the rest of the mesh left out of the "
+            "matching and weighted like the nearest kept vertex\n" in "".join(capfd.readouterr()))
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+
+
+@pytest.mark.parametrize("which", ["Body", "Sleeve"])
+@pytest.mark.parametrize("value", [float("inf"), float("nan")])
+def test_a_non_finite_vertex_is_refused_naming_its_object(rig, which, value):
+    bpy.data.objects[which].data.vertices[3].co.z = value  # Blender stores inf as the float32 maximum
+    bpy.context.view_layer.update()
+    assert_refused_unchanged(
+        rig, f"'{which}' has a vertex at an infinite or undefined (NaN) position (index 3): move or delete it in "
+        "Edit Mode first.", source="Body", targets="Sleeve",
+    )
+
+
+def test_transfer_works_in_weight_paint_and_pose_mode(rig):
+    select_only([rig.sleeve], active=rig.sleeve)
+    bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
+    assert rig.sleeve.mode == "WEIGHT_PAINT"
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    rig.sleeve.vertex_groups.clear()
+    # The armature in Pose Mode and posed: weights still come from the rest shape.
+    select_only([rig.armature], active=rig.armature)
+    bpy.ops.object.mode_set(mode="POSE")
+    rig.armature.pose.bones[UPPER_BONE].rotation_quaternion = (0.7071068, 0.7071068, 0.0, 0.0)
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    bpy.ops.object.mode_set(mode="OBJECT")

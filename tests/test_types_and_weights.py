@@ -6,12 +6,13 @@ from autorig_addon.core.errors import InputError
 from autorig_addon.core.geometry.bounding_box import bounding_box_diagonal, character_size, checked_size
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 from autorig_addon.core.weights import (
-    check_weights,
     empty_rows,
+    invalid_rows,
     limit_influences,
     mix_weights,
     normalize_rows,
     prune_small,
+    usable_rows,
 )
 
 
@@ -120,9 +121,7 @@ def test_mix_changes_only_the_chosen_columns():
         mix_weights(existing, incoming[:, :2], 0.5)
 
 
-def test_check_weights_refuses_nan_and_negative():
-    with pytest.raises(InputError, match=r"The weights contain NaN or infinite values; fix or clean them \(Weights > Clean\)"):
-        check_weights(np.array([[np.nan]]))
-    with pytest.raises(InputError, match=r"The skin contain negative values; clean them \(Weights > Clean\) first"):
-        check_weights(np.array([[-0.5]]), "skin")
-    check_weights(np.array([[0.5, 0.5]]))
+def test_rows_with_nan_infinite_or_negative_weights_are_invalid_and_empty_ones_unusable():
+    weights = np.array([[0.5, 0.5], [np.nan, 1.0], [np.inf, 0.0], [1.0, -0.5], [0.0, 0.0], [5e-5, 5e-5], [0.0, 0.2]])
+    np.testing.assert_array_equal(invalid_rows(weights), [False, True, True, True, False, False, False])
+    np.testing.assert_array_equal(usable_rows(weights), [True, False, False, False, False, False, True])

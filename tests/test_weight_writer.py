@@ -30,15 +30,51 @@ def random_weights(vertex_count, names, seed=0):
     return Weights(matrix, names)
 
 
-def test_fill_group_adds_each_vertex_with_its_weight(clean_scene):
+def member_weights(obj, name):
+    """{vertex index: weight} of the members of group ``name``, read element by element."""
+    index = obj.vertex_groups[name].index
+    return {v.index: e.weight for v in obj.data.vertices for e in v.groups if e.group == index}
+
+
+def test_fill_groups_stores_exact_weights_and_keeps_order_lock_and_active(clean_scene):
     vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
     box = mesh_object("Box", vertices, faces)
-    group = box.vertex_groups.new(name="Group")
-    # Repeated values share one add() call; the order of the indices must not matter.
-    weight_writer.fill_group(group, np.array([6, 1, 3, 0]), np.array([0.25, 0.5, 0.25, 1.0]))
-    np.testing.assert_allclose(group_weights(box, ["Group"])[:, 0], [1.0, 0.5, 0, 0.25, 0, 0, 0.25, 0])
-    weight_writer.clear_group(group, 8)
-    assert not any(vertex.groups for vertex in box.data.vertices)
+    first = box.vertex_groups.new(name="First")
+    first.add([0, 1], 0.5, "REPLACE")
+    first.lock_weight = True
+    box.vertex_groups.new(name="Mask").add([7], 1.0, "REPLACE")
+    box.vertex_groups.active_index = 1
+    box.data.color_attributes.new("Paint", "FLOAT_COLOR", "POINT")
+    box.data.attributes.active = box.data.attributes["Paint"]
+    attributes_before = sorted(attribute.name for attribute in box.data.attributes)
+    third = np.float32(1.0) / np.float32(3.0)
+    weight_writer.fill_groups(box, {
+        "New": np.array([0.0, 0.25, 0.0, 1e-7, 0.0, 0.0, -0.5, 2.0]),
+        "First": np.array([third, 0, 0, 0, 0, 0, 0.75, 0]),
+    })
+    # Refilled in place (first, still locked), new groups appended, the active group unchanged.
+    assert [group.name for group in box.vertex_groups] == ["First", "Mask", "New"]
+    assert box.vertex_groups["First"].lock_weight and not box.vertex_groups["New"].lock_weight
+    assert box.vertex_groups.active.name == "Mask"
+    # Exactly the float32 values; zero and negative weights are not members.
+    assert member_weights(box, "First") == {0: third, 6: 0.75}
+    assert member_weights(box, "New") == {1: 0.25, 3: np.float32(1e-7), 7: 2.0}
+    assert member_weights(box, "Mask") == {7: 1.0}
+    # No temporary attribute is left, and the active attribute is the same.
+    assert sorted(attribute.name for attribute in box.data.attributes) == attributes_before
+    assert box.data.attributes.active.name == "Paint"
+
+
+def test_fill_groups_moves_a_refilled_group_back_between_others(clean_scene):
+    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
+    box = mesh_object("Box", vertices, faces)
+    for name in ("A", "B", "C", "D"):
+        box.vertex_groups.new(name=name).add([0], 0.5, "REPLACE")
+    weight_writer.fill_groups(box, {"B": np.full(8, 0.25), "A": np.zeros(8)})
+    assert [group.name for group in box.vertex_groups] == ["A", "B", "C", "D"]
+    assert member_weights(box, "A") == {}
+    assert member_weights(box, "B") == {i: 0.25 for i in range(8)}
+    assert member_weights(box, "C") == {0: 0.5}
 
 
 def test_write_weights_round_trip_preserves_other_groups_and_skips_zeros(clean_scene):
@@ -128,3 +164,17 @@ def test_write_weights_refuses_bad_input_before_changing_anything(clean_scene):
         weight_writer.write_weights(rig.sleeve, Weights(np.ones((552, 1)), (LOWER_BONE,)), rig.body)
     assert [group.name for group in rig.sleeve.vertex_groups] == groups_before
     assert len(rig.sleeve.modifiers) == 0 and rig.sleeve.parent is None
+
+
+def test_binding_replaces_a_bone_parent_keeping_the_world_transform(clean_scene):
+    from blender_fixtures import evaluated_world_vertices, parent_to_bone
+
+    rig = build_rig_scene()
+    parent_to_bone(rig.sleeve, rig.armature, UPPER_BONE)
+    before = evaluated_world_vertices(rig.sleeve)
+    weights = random_weights(len(rig.sleeve.data.vertices), (LOWER_BONE, UPPER_BONE))
+    weight_writer.write_weights(rig.sleeve, weights, rig.armature)
+    bpy.context.view_layer.update()
+    # Carried by the Armature modifier only: never also by the bone.
+    assert (rig.sleeve.parent, rig.sleeve.parent_type, rig.sleeve.parent_bone) == (rig.armature, "OBJECT", "")
+    np.testing.assert_allclose(evaluated_world_vertices(rig.sleeve), before, atol=1e-6)

@@ -131,14 +131,19 @@ def read_mesh(objects, depsgraph=None) -> Mesh:
 
 @contextmanager
 def armatures_at_rest(objects):
-    """Put the armatures deforming ``objects`` in Rest Position while the
-    block runs: weights belong to the rest shape, and some files (CesiumMan)
-    import posed. The pose setting is restored afterwards."""
+    """Put the armatures deforming ``objects`` (through an Armature modifier,
+    or carrying them on a bone) in Rest Position while the block runs:
+    weights belong to the rest shape, and some files (CesiumMan) import
+    posed. The pose setting is restored afterwards."""
     armatures = {
         modifier.object
         for obj in objects if obj is not None and obj.type == "MESH"
         for modifier in obj.modifiers
         if modifier.type == "ARMATURE" and modifier.object is not None
+    }
+    armatures |= {
+        obj.parent for obj in objects
+        if obj is not None and obj.parent is not None and obj.parent.type == "ARMATURE" and obj.parent_type == "BONE"
     }
     posed = [armature for armature in armatures if armature.data.pose_position != "REST"]
     for armature in posed:

@@ -1,7 +1,7 @@
 """Snapshots of what the writers change on a mesh object, for all-or-nothing writes.
 
-:class:`ObjectSnapshot` records an object's vertex groups, Armature
-modifiers, parent and transform, and status attributes;
+:class:`ObjectSnapshot` records an object's mesh datablock, vertex groups,
+Armature modifiers, parent and transform, and status attributes;
 :func:`restored_on_failure` takes one of every object a block is about to
 write and restores them all if the block raises, as the glTF importer
 cleans up its helper objects in ``finally``.
@@ -13,12 +13,13 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Iterable
 
+import bpy
 import numpy as np
 from mathutils import Matrix
 
 from .convert import read_group_weights
 from .status_attribute import STATUS_ATTRIBUTE_NAMES, remove_status_attributes
-from .weight_writer import fill_group
+from .weight_writer import fill_groups
 
 #: Armature modifier settings a snapshot records, so a removed one can be rebuilt.
 _ARMATURE_MODIFIER_SETTINGS = (
@@ -69,12 +70,14 @@ class ObjectSnapshot:
     """
 
     obj: object
+    mesh: object = None
     groups: list = field(default_factory=list)
     active_group_index: int = -1
     modifier_names: list = field(default_factory=list)
     armature_modifiers: list = field(default_factory=list)
     parent: object = None
     parent_type: str = "OBJECT"
+    parent_bone: str = ""
     matrix_parent_inverse: Matrix = None
     matrix_basis: Matrix = None
     attributes: list = field(default_factory=list)
@@ -82,7 +85,7 @@ class ObjectSnapshot:
 
     @classmethod
     def capture(cls, obj) -> "ObjectSnapshot":
-        snapshot = cls(obj)
+        snapshot = cls(obj, obj.data)
         group_names = [group.name for group in obj.vertex_groups]
         matrix = read_group_weights(obj, group_names)
         for column, group in enumerate(obj.vertex_groups):
@@ -99,6 +102,7 @@ class ObjectSnapshot:
         ]
         snapshot.parent = obj.parent
         snapshot.parent_type = obj.parent_type
+        snapshot.parent_bone = obj.parent_bone
         snapshot.matrix_parent_inverse = obj.matrix_parent_inverse.copy()
         snapshot.matrix_basis = obj.matrix_basis.copy()
         mesh_data = obj.data
@@ -112,11 +116,20 @@ class ObjectSnapshot:
 
     def restore(self) -> None:
         obj = self.obj
+        if obj.data != self.mesh:
+            # A write gave a linked duplicate its own mesh: share the original again.
+            own = obj.data
+            obj.data = self.mesh
+            if own.users == 0:
+                bpy.data.meshes.remove(own)
         obj.vertex_groups.clear()
+        vertex_count = len(obj.data.vertices)
         for state in self.groups:
-            group = obj.vertex_groups.new(name=state.name)
-            fill_group(group, state.indices, state.weights)
-            group.lock_weight = state.lock_weight
+            # One group at a time: all of them dense at once could take gigabytes.
+            column = np.zeros(vertex_count)
+            column[state.indices] = state.weights
+            fill_groups(obj, {state.name: column})
+            obj.vertex_groups[state.name].lock_weight = state.lock_weight
         if self.groups:
             obj.vertex_groups.active_index = max(self.active_group_index, 0)
         for modifier in list(obj.modifiers):
@@ -134,6 +147,7 @@ class ObjectSnapshot:
                 obj.modifiers.move(current, min(state.index, len(obj.modifiers) - 1))
         obj.parent = self.parent
         obj.parent_type = self.parent_type
+        obj.parent_bone = self.parent_bone
         obj.matrix_parent_inverse = self.matrix_parent_inverse
         obj.matrix_basis = self.matrix_basis
         _restore_attributes(obj.data, self.attributes, self.active_color_name)

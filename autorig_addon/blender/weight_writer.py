@@ -1,8 +1,19 @@
 """Writing skin weights into a mesh: vertex groups and the armature binding.
 
-There is no ``foreach_set`` for deform weights, so a vertex group is filled
-through ``VertexGroup.add`` once per distinct weight value, the fastest
-path the Python API offers.
+There is no ``foreach_set`` for deform weights, and ``VertexGroup.add``
+takes one weight per call: continuous weights (every vertex its own value)
+cost one call per vertex and group. Instead each group goes in whole: its
+weights into a temporary float point attribute with ``foreach_set``, which
+Blender's *Convert Attribute* operator turns into a vertex group (vertices
+of weight 0 are not members; the float32 values are stored exactly).
+
+``bpy.ops`` re-evaluates the context's view layer around every operator
+call, which re-runs the object's modifiers (its Armature modifier, when the
+mesh is already bound) once per group and costs more than the conversion
+itself. The operators therefore run with a temporary, empty scene as their
+context (:func:`_operator_context`), so that evaluation is empty; the
+object is evaluated once, when the job is done. Measured:
+``bench/bench_weight_writer.py``, ``docs/benchmarks.md``.
 
 The writers change the object in place and are not all-or-nothing by
 themselves: a caller wraps all of its writes in
@@ -12,8 +23,10 @@ restores every object it was writing.
 
 from __future__ import annotations
 
-from typing import Sequence
+from contextlib import contextmanager
+from typing import Mapping, Sequence
 
+import bpy
 import numpy as np
 
 from ..core.errors import InputError
@@ -22,40 +35,117 @@ from .convert import deform_bone_names, require_armature_object, require_mesh_ob
 
 #: Name given to the Armature modifier this add-on creates.
 ARMATURE_MODIFIER_NAME = "Armature"
+#: Start of the temporary attribute names a group is written through.
+_TEMPORARY_ATTRIBUTE_PREFIX = "autorig_group_"
+#: Name of the temporary scene the conversions run in (removed afterwards).
+_SCRATCH_SCENE_NAME = "AutoRig scratch"
 
 
-def fill_group(group, indices: np.ndarray, weights: np.ndarray) -> None:
-    """Add vertices to a vertex group, one ``add`` call per distinct weight value.
+def _unused_attribute_name(obj) -> str:
+    """A name neither an attribute nor a vertex group of ``obj`` uses."""
+    taken = {attribute.name for attribute in obj.data.attributes} | {group.name for group in obj.vertex_groups}
+    number = 0
+    while f"{_TEMPORARY_ATTRIBUTE_PREFIX}{number}" in taken:
+        number += 1
+    return f"{_TEMPORARY_ATTRIBUTE_PREFIX}{number}"
+
+
+@contextmanager
+def _operator_context(obj):
+    """Run ``bpy.ops`` on ``obj`` with a temporary empty scene as the context's
+    scene and view layer, so the view-layer updates around each call
+    evaluate nothing (module docstring); the scene is always removed."""
+    scene = bpy.data.scenes.new(_SCRATCH_SCENE_NAME)
+    try:
+        with bpy.context.temp_override(object=obj, active_object=obj, scene=scene, view_layer=scene.view_layers[0]):
+            yield
+    finally:
+        bpy.data.scenes.remove(scene)
+
+
+def _new_group_from_values(obj, name: str, values: np.ndarray):
+    """A new vertex group ``name`` holding ``values`` (members: values > 0),
+    converted from a temporary attribute; call inside :func:`_operator_context`."""
+    mesh = obj.data
+    attribute = mesh.attributes.new(_unused_attribute_name(obj), "FLOAT", "POINT")
+    temporary = attribute.name
+    attribute.data.foreach_set("value", np.where(values > 0, values, 0.0).astype(np.float32))
+    mesh.attributes.active = attribute
+    bpy.ops.geometry.attribute_convert(mode="VERTEX_GROUP")
+    group = obj.vertex_groups[temporary]
+    group.name = name
+    return group
+
+
+def _move_group(obj, source: int, destination: int) -> None:
+    """Move the vertex group at index ``source`` up to index ``destination``
+    (Blender moves a group one place per call); call inside :func:`_operator_context`."""
+    obj.vertex_groups.active_index = source
+    for _ in range(source - destination):
+        bpy.ops.object.vertex_group_move(direction="UP")
+
+
+def fill_groups(obj, values: Mapping[str, np.ndarray]) -> None:
+    """Set each named vertex group of ``obj`` to exactly the given weights.
 
     Parameters
     ----------
-    group : bpy.types.VertexGroup
-    indices : (k,) int array, vertex indices
-    weights : (k,) float array, their weights
+    obj : bpy.types.Object of type 'MESH'
+    values : mapping of group name -> (n,) float array, one weight per vertex
+        Vertices with a weight of 0 or less are not members. Weights are
+        stored as float32, exactly.
+
+    An existing group keeps its place in the list and its lock; new groups
+    are appended in the mapping's order; the active group stays active.
     """
-    if not len(indices):
+    if not values:
         return
-    values, inverse = np.unique(np.asarray(weights, dtype=np.float32), return_inverse=True)
-    order = np.argsort(inverse, kind="stable")
-    boundaries = np.flatnonzero(np.diff(inverse[order])) + 1
-    for value, members in zip(values, np.split(np.asarray(indices)[order], boundaries)):
-        group.add(members.tolist(), float(value), "REPLACE")
+    groups = obj.vertex_groups
+    order = [group.name for group in groups]
+    order += [name for name in values if name not in order]
+    locks = {group.name: group.lock_weight for group in groups if group.name in values}
+    active = groups.active.name if groups.active is not None else None
+    attributes = obj.data.attributes
+    active_attribute = attributes.active.name if attributes.active is not None else None
+    for name in values:
+        if groups.get(name) is not None:
+            groups.remove(groups[name])
+    with _operator_context(obj):
+        for name, weights in values.items():
+            group = _new_group_from_values(obj, name, np.asarray(weights, dtype=np.float64).reshape(-1))
+            group.lock_weight = locks.get(name, False)
+        # Refilled groups were appended: move each back to its place (one
+        # move per group it passes; none when the refilled groups come last).
+        for index, name in enumerate(order):
+            current = groups[name].index
+            if current != index:
+                _move_group(obj, current, index)
+    if active is not None:
+        groups.active_index = groups[active].index
+    if active_attribute is not None and attributes.get(active_attribute) is not None:
+        attributes.active = attributes[active_attribute]
 
 
-def clear_group(group, vertex_count: int) -> None:
-    """Remove every one of the mesh's ``vertex_count`` vertices from ``group``."""
-    if vertex_count:
-        group.remove(list(range(vertex_count)))
-
-
-def ensure_armature_binding(obj, armature_obj) -> None:
+def ensure_armature_binding(obj, armature_obj, world=None) -> None:
     """Give ``obj`` exactly one Armature modifier, on ``armature_obj``, and
-    parent it to the armature, keeping its world transform.
+    parent it to the armature object (never to a bone, nor with the old
+    *Armature* parent type: either would move it a second time), keeping
+    its world transform.
 
     An existing Armature modifier is reused (one on this armature first,
     then an empty one, then one on another armature, which is retargeted);
     every other Armature modifier is removed, or the mesh would be deformed
-    twice. :class:`~.snapshot.ObjectSnapshot` can rebuild them."""
+    twice. :class:`~.snapshot.ObjectSnapshot` can rebuild them.
+
+    Parameters
+    ----------
+    obj : bpy.types.Object of type 'MESH'
+    armature_obj : bpy.types.Object of type 'ARMATURE'
+    world : mathutils.Matrix or None
+        World matrix to keep when the parent changes (default: the current
+        one). A prop carried by a bone of a posed armature passes its rest
+        one (:class:`~.object_roles.RigidBinding`).
+    """
     armature_modifiers = [m for m in obj.modifiers if m.type == "ARMATURE"]
     ranked = sorted(armature_modifiers, key=lambda m: (m.object != armature_obj, m.object is not None))
     if ranked:
@@ -69,10 +159,11 @@ def ensure_armature_binding(obj, armature_obj) -> None:
         # Deform before anything else (subdivision, solidify) as Ctrl+P does.
         obj.modifiers.move(len(obj.modifiers) - 1, 0)
     keep.use_vertex_groups = True
-    if obj.parent != armature_obj:
-        world = obj.matrix_world.copy()
+    if obj.parent != armature_obj or obj.parent_type != "OBJECT":
+        world = (obj.matrix_world if world is None else world).copy()
         obj.parent = armature_obj
         obj.parent_type = "OBJECT"
+        obj.parent_bone = ""
         obj.matrix_parent_inverse = armature_obj.matrix_world.inverted_safe()
         obj.matrix_basis = world
 
@@ -83,7 +174,8 @@ def _writable_columns(weights: Weights, armature_obj) -> list[int]:
     return [k for k, name in enumerate(weights.bone_names) if name in deform]
 
 
-def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = False, keep_groups: Sequence[str] = ()) -> None:
+def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = False, keep_groups: Sequence[str] = (),
+                  world=None) -> None:
     """Store ``weights`` in ``obj``'s vertex groups and bind it to the armature
     (:func:`ensure_armature_binding`).
 
@@ -100,6 +192,7 @@ def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = Fa
         refilled, other groups stay.
     keep_groups : sequence of str
         Groups ``replace_all`` leaves alone (the artist's mask groups).
+    world : mathutils.Matrix or None, passed to :func:`ensure_armature_binding`
 
     Raises
     ------
@@ -120,16 +213,24 @@ def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = Fa
         for group in list(obj.vertex_groups):
             if group.name not in keep_groups:
                 obj.vertex_groups.remove(group)
+    used = np.any(weights.matrix > 0, axis=0)
+    values = {}
     for column in columns:
         name = weights.bone_names[column]
-        values = weights.matrix[:, column]
-        members = np.flatnonzero(values > 0)
-        group = obj.vertex_groups.get(name)
-        if group is None:
-            if not len(members):
-                continue
-            group = obj.vertex_groups.new(name=name)
-        else:
-            clear_group(group, vertex_count)
-        fill_group(group, members, values[members])
-    ensure_armature_binding(obj, armature_obj)
+        # A bone with no weight anywhere gets no new group, and an existing one is emptied.
+        if used[column] or obj.vertex_groups.get(name) is not None:
+            values[name] = weights.matrix[:, column]
+    fill_groups(obj, values)
+    ensure_armature_binding(obj, armature_obj, world)
+
+
+def bind_to_bone(obj, armature_obj, bone: str, rest_world) -> None:
+    """Bind a prop wholly to one deform bone: every vertex in that bone's
+    group with weight 1, the other deform bones' groups emptied, and the
+    armature as object parent, placed at ``rest_world`` (its world matrix
+    with the armature at rest), so the Armature modifier moves it as its
+    bone parent did."""
+    names = deform_bone_names(armature_obj)
+    matrix = np.zeros((len(obj.data.vertices), len(names)))
+    matrix[:, names.index(bone)] = 1.0
+    write_weights(obj, Weights(matrix, names), armature_obj, world=rest_world)

@@ -11,6 +11,7 @@ import contextlib
 import json
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Callable
@@ -126,15 +127,54 @@ def output_paths(items: list[tuple[Path, Path]], out: str, is_batch: bool, outpu
     return paths
 
 
+def check_outputs(outputs: list[Path], summary_file: str | None = None) -> None:
+    """Raise :class:`UsageError` unless every output can be written: a
+    format ``scene_io.save_scene`` writes, and a folder (existing, or to be
+    created inside an existing one) that accepts new files; likewise the
+    folder of the ``--summary`` file. Run before any input is processed, so
+    a bad ``--out`` never costs a whole computation.
+    """
+    for path in outputs:
+        if path.suffix.lower() not in SAVABLE_EXTENSIONS:
+            raise UsageError(
+                f"--out {str(path)!r}: cannot write '{path.suffix or 'extension-less'}' files; "
+                f"use one of {', '.join(SAVABLE_EXTENSIONS)}, or a folder."
+            )
+        if path.is_dir():
+            raise UsageError(f"--out {str(path)!r} is a folder; name a file in it.")
+    for folder in sorted({path.parent for path in outputs}):
+        check_writable_folder(folder, "--out")
+    if summary_file:
+        check_writable_folder(Path(summary_file).parent, "--summary")
+
+
+def check_writable_folder(folder: Path, option: str) -> None:
+    """Raise :class:`UsageError` naming ``option`` unless files can be
+    created in ``folder``: its nearest existing ancestor (folders are created
+    as needed) must be a folder that accepts a new file."""
+    existing = Path(folder).absolute()
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise UsageError(f"{option}: {str(existing)!r} is a file, not a folder; nothing can be written inside it.")
+    try:
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as error:
+        raise UsageError(f"{option}: cannot write in the folder {str(existing)!r} ({error.strerror or error}).") from None
+
+
 def run_batch(inputs: list[str], out: str, output_format: str, process: Callable, summary_file: str | None, quiet: bool = False) -> int:
     """Run ``process(input_path, output_path, progress) -> dict`` on every input.
 
+    The outputs are checked first (:func:`check_outputs`, a usage error).
     One failing input is recorded and the batch goes on. The summary
     ``{"succeeded": [{"input", "output", ...}], "failed": [{"input", "error"}]}``
     is printed to stdout as JSON and written to ``summary_file`` if given.
     """
     items, is_batch = expand_inputs(inputs)
     outputs = output_paths(items, out, is_batch, output_format)
+    check_outputs(outputs, summary_file)
     bar = TextProgress(len(items), _NullStream() if quiet else None)
     summary = {"succeeded": [], "failed": []}
     for index, ((input_path, _), output_path) in enumerate(zip(items, outputs)):

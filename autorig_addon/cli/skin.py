@@ -41,12 +41,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Remove every existing vertex group first (default: only the deform bones' groups)")
 
 
+def split_mesh_names(mesh_names: list[str]) -> list[str]:
+    """The mesh names of repeated or comma-separated ``--mesh`` options."""
+    from ..blender.operators.transfer import split_names
+
+    return [name for text in mesh_names for name in split_names(text)]
+
+
 def skin_objects(armature_name: str, mesh_names: list[str]):
     """The armature and meshes a skin run binds, from names or the file's content."""
     import bpy
 
     from ..blender import scene_io
-    from ..blender.operators.transfer import split_names
 
     if armature_name:
         armature = scene_io.find_object(armature_name, "ARMATURE")
@@ -56,11 +62,12 @@ def skin_objects(armature_name: str, mesh_names: list[str]):
             found = ", ".join(obj.name for obj in armatures) or "none"
             raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
         armature = armatures[0]
-    names = [name for text in mesh_names for name in split_names(text)]
+    names = split_mesh_names(mesh_names)
     if names:
         return armature, [scene_io.find_object(name, "MESH") for name in names]
-    shapes = {bone.custom_shape for obj in bpy.data.objects if obj.type == "ARMATURE" for bone in obj.pose.bones}
-    meshes = [obj for obj in bpy.data.objects if obj.type == "MESH" and obj not in shapes]
+    # Every mesh: the plan (named=False) leaves out helpers such as bone shapes
+    # and leaves props parented to a bone rigid.
+    meshes = [obj for obj in bpy.data.objects if obj.type == "MESH"]
     if not meshes:
         raise InputError("The file holds no mesh to skin.")
     return armature, meshes
@@ -79,15 +86,18 @@ def run(args: argparse.Namespace) -> int:
 
         scene_io.load_scene(input_path)
         armature, meshes = skin_objects(args.armature, args.mesh)
-        plan = plan_skin(armature, meshes, settings, bpy.context.evaluated_depsgraph_get())
+        plan = plan_skin(armature, meshes, settings, bpy.context.evaluated_depsgraph_get(),
+                         named=bool(split_mesh_names(args.mesh)))
         weights = compute_skin(plan, progress)
         write_skin(plan, weights)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)
-        details = {"armature": armature.name, "meshes": [obj.name for obj in meshes],
+        details = {"armature": armature.name, "meshes": [obj.name for obj in plan.meshes],
                    "bones": len(weights.bone_names), "vertices": int(weights.matrix.shape[0])}
         if plan.tail_decision.any_derived:
             details["tails"] = plan.tail_decision.note
+        if plan.notes:
+            details["notes"] = plan.notes
         return details
 
     return run_batch(args.inputs, args.out, args.format, process, args.summary, args.quiet)

@@ -60,6 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--bones", default="", help="Comma-separated bones to transfer (default: all deform bones)")
     parser.add_argument("--mix", type=fraction, default=None,
                         help="Share of the transferred weights when mixing, 0 to 1 (implies --replace mix)")
+    parser.add_argument("--allow-poor-match", action="store_true", default=defaults.DEFAULT_ALLOW_POOR_MATCH,
+                        help="Transfer even when almost nothing matches, another unit scale fits much better, or "
+                             "matches are far from the body, instead of refusing (default off)")
     parser.add_argument("--replace", choices=tuple(REPLACE_CHOICES), default=None,
                         help="transfer: refill the transferred bones' groups; mix: blend with existing weights; "
                              f"all: remove every group first (default {DEFAULT_REPLACE_CHOICE}, or mix with --mix)")
@@ -83,19 +86,12 @@ def transfer_settings(args: argparse.Namespace):
 
 
 def default_targets(source) -> list:
-    """Every mesh other than ``source`` not yet bound to an armature."""
-    import bpy
+    """Every mesh other than ``source`` not yet bound to an armature (props
+    parented to a bone included: the transfer leaves them rigid and says so;
+    helper objects such as bone shapes are left out by the transfer)."""
+    from ..blender.operators.transfer import unbound_meshes
 
-    from ..blender.convert import find_armature
-
-    targets = []
-    for obj in bpy.data.objects:
-        if obj.type != "MESH" or obj == source:
-            continue
-        try:
-            find_armature(obj)
-        except InputError:
-            targets.append(obj)
+    targets = unbound_meshes(source)
     if not targets:
         raise InputError("No target given and every other mesh is already rigged: name the meshes with --target.")
     return targets
@@ -112,7 +108,8 @@ def transfer_file(args: argparse.Namespace, settings, input_path: Path, output_p
     source = scene_io.find_object(args.source, "MESH")
     names = [name for text in args.target for name in split_names(text)]
     targets = [scene_io.find_object(name, "MESH") for name in names] if names else default_targets(source)
-    outcomes = run_transfer(source, targets, settings, bpy.context.evaluated_depsgraph_get(), progress)
+    outcomes = run_transfer(source, targets, settings, bpy.context.evaluated_depsgraph_get(), progress,
+                            named=bool(names))
     progress(1.0, "Saving")
     scene_io.save_scene(output_path)
     return {"targets": {outcome.target.name: outcome.summary for outcome in outcomes}}

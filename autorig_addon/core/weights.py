@@ -1,7 +1,8 @@
-"""Operations on weight matrices: clean-up, influence limits, mixing.
+"""Operations on weight matrices: clean-up, which rows can be used,
+influence limits, mixing.
 
-Every function takes and returns a dense ``(n, b)`` float64 array; none
-modifies its input.
+Every function takes a dense ``(n, b)`` array and returns one, or an
+``(n,)`` bool array for the row tests; none modifies its input.
 """
 
 from __future__ import annotations
@@ -23,7 +24,9 @@ def normalize_rows(weights: np.ndarray) -> np.ndarray:
     Rows that are zero everywhere stay zero; callers decide how to fill
     them (see :func:`empty_rows`).
     """
-    clean = np.nan_to_num(np.asarray(weights, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    clean = np.asarray(weights, dtype=np.float64)
+    if not np.isfinite(clean).all():  # checking first halves the time on big clean matrices
+        clean = np.nan_to_num(clean, nan=0.0, posinf=0.0, neginf=0.0)
     clean = np.maximum(clean, 0.0)
     sums = clean.sum(axis=1, keepdims=True)
     return np.divide(clean, sums, out=np.zeros_like(clean), where=sums > 0)
@@ -32,6 +35,33 @@ def normalize_rows(weights: np.ndarray) -> np.ndarray:
 def empty_rows(weights: np.ndarray) -> np.ndarray:
     """(n,) bool: rows with no weight above :data:`INFLUENCE_EPSILON`."""
     return ~(np.asarray(weights) > INFLUENCE_EPSILON).any(axis=1)
+
+
+def invalid_rows(weights: np.ndarray) -> np.ndarray:
+    """(n,) bool: rows with a NaN, infinite or negative entry (corrupt
+    weights: Blender's vertex groups can hold NaN, and files anything).
+
+    Examples
+    --------
+    >>> invalid_rows(np.array([[0.5, 0.5], [np.nan, 1.0], [1.0, -0.5], [0.0, 0.0]])).tolist()
+    [False, True, True, False]
+    """
+    weights = np.asarray(weights, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        return ~np.all(np.isfinite(weights) & (weights >= 0.0), axis=1)
+
+
+def usable_rows(weights: np.ndarray) -> np.ndarray:
+    """(n,) bool: rows that can be copied: valid (not :func:`invalid_rows`)
+    and not empty (some weight above :data:`INFLUENCE_EPSILON`).
+
+    Examples
+    --------
+    >>> usable_rows(np.array([[0.5, 0.5], [np.nan, 1.0], [0.0, 0.0], [1e-6, 0.0]])).tolist()
+    [True, False, False, False]
+    """
+    weights = np.asarray(weights, dtype=np.float64)
+    return ~invalid_rows(weights) & ~empty_rows(np.nan_to_num(weights))
 
 
 def limit_influences(weights: np.ndarray, max_influences: int) -> np.ndarray:
@@ -75,12 +105,3 @@ def mix_weights(existing: np.ndarray, incoming: np.ndarray, factor: float, colum
     cols = np.arange(existing.shape[1]) if columns is None else np.asarray(columns)
     mixed[:, cols] = (1.0 - factor) * existing[:, cols] + factor * incoming[:, cols]
     return normalize_rows(mixed)
-
-
-def check_weights(weights: np.ndarray, what: str = "weights") -> None:
-    """Raise :class:`InputError` for NaN/inf or negative entries."""
-    weights = np.asarray(weights)
-    if not np.all(np.isfinite(weights)):
-        raise InputError(f"The {what} contain NaN or infinite values; fix or clean them (Weights > Clean) first.")
-    if np.any(weights < -1e-9):
-        raise InputError(f"The {what} contain negative values; clean them (Weights > Clean) first.")

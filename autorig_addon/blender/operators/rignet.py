@@ -22,13 +22,22 @@ from ..armature_builder import build_armature
 from ..snapshot import restored_on_failure
 from ..weight_writer import write_weights
 
+#: Importing onto a mesh is refused when the file would leave more than this
+#: share of its vertices without weight: the rig was made for another mesh.
+#: (Fewer unweighted vertices are legal: the format has no line for a vertex
+#: without weight, so a file cannot say how many trailing vertices it skips.)
+MAX_UNWEIGHTED_SHARE = 0.5
+
 
 def import_rignet_rig(context, filepath: str, mesh_obj=None):
     """Build the armature of a RigNet file; bind ``mesh_obj`` with its weights.
 
-    Returns the armature object. ``mesh_obj`` (optional) must have the
-    vertex count the file's ``skin`` lines refer to. All-or-nothing: on
-    failure nothing is left in the scene and the mesh is unchanged.
+    Returns the armature object. ``mesh_obj`` (optional) must have more
+    vertices than the file's largest ``skin`` index, and the file must weight
+    at least ``1 - MAX_UNWEIGHTED_SHARE`` of them (vertices without a ``skin``
+    line stay unweighted: see :func:`unweighted_vertex_count`).
+    All-or-nothing: on failure nothing is left in the scene and the mesh is
+    unchanged.
     """
     vertex_count = len(mesh_obj.data.vertices) if mesh_obj is not None else None
     skeleton, weights = read_rignet_rig(filepath, vertex_count=vertex_count)
@@ -50,16 +59,22 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
     return armature
 
 
+def unweighted_vertex_count(weights) -> int:
+    """Vertices a file's weights leave without any weight (no ``skin`` line)."""
+    return int(np.count_nonzero(~weights.matrix.any(axis=1)))
+
+
 def _check_weights_cover_mesh(weights, mesh_obj) -> None:
-    """Refuse a mesh with more vertices than the file weights: the file's
-    last skinned vertex must be the mesh's last vertex (fewer vertices are
-    refused while reading the file)."""
-    skinned = np.flatnonzero(weights.matrix.any(axis=1))
+    """Refuse a mesh the file leaves mostly unweighted: it is not the mesh
+    the rig was made for (a larger index than the mesh has is refused while
+    reading the file)."""
     vertex_count = len(mesh_obj.data.vertices)
-    if len(skinned) and skinned[-1] + 1 != vertex_count:
+    unweighted = unweighted_vertex_count(weights)
+    if unweighted > MAX_UNWEIGHTED_SHARE * vertex_count:
         raise InputError(
-            f"The file weights vertices up to {skinned[-1]}, but '{mesh_obj.name}' has {vertex_count} vertices: "
-            "it is not the mesh the rig was made for. Import without a mesh selected to get the armature alone."
+            f"The file weights {vertex_count - unweighted} of the {vertex_count} vertices of '{mesh_obj.name}' "
+            "and leaves the rest without weight: it is not the mesh the rig was made for. "
+            "Import without a mesh selected to get the armature alone."
         )
 
 
@@ -94,7 +109,12 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
         except (InputError, OSError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        bound = f", '{mesh_obj.name}' bound" if mesh_obj is not None and mesh_obj.parent == armature else ""
+        bound = ""
+        if mesh_obj is not None and mesh_obj.parent == armature:
+            unweighted = unweighted_vertex_count(convert.read_weights(mesh_obj, armature.data.bones.keys()))
+            stays = (f" ({unweighted} of its vertices have no weight in the file and stay in place when posed)"
+                     if unweighted else "")
+            bound = f", '{mesh_obj.name}' bound{stays}"
         self.report({"INFO"}, f"Imported '{armature.name}' with {len(armature.data.bones)} bones{bound}.")
         return {"FINISHED"}
 

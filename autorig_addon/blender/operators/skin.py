@@ -7,6 +7,10 @@ As with transfer, nothing is written before everything is computed:
 3. :func:`write_skin` writes every mesh, restoring all of them if any
    write fails.
 
+What the plan does with props parented to a bone, helper objects, linked
+duplicates and stray vertices: :mod:`..object_roles` and
+:mod:`autorig_addon.core.geometry.outliers`; each is named in the report.
+
 From the UI the operator runs step 2 in a worker thread so Blender stays
 responsive, shows progress and stops on Esc; in background mode (scripts,
 the command line) it runs synchronously.
@@ -15,7 +19,7 @@ the command line) it runs synchronously.
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
@@ -27,12 +31,15 @@ from ...core.progress import ProgressCallback
 from ...core.skeleton.tails import TailDecision, with_reliable_tails
 from ...core.types import Mesh, Skeleton, Weights
 from ...core.distances.grid import DEFAULT_RESOLUTION
+from ...core.geometry.outliers import require_finite_positions, rows_for_strays
 from .. import convert
+from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
 from ..progress import PROGRESS_STEPS, blender_progress, progress_step, progress_text
 from ..scene_io import find_object
 from ..snapshot import restored_on_failure
 from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
-from ..weight_writer import write_weights
+from ..weight_writer import bind_to_bone, write_weights
+from .input_checks import check_mode, mode_poll, split_strays, stray_notes
 
 #: When even the deform bone point nearest the mesh's bounding box is
 #: farther than this many mesh diagonals from it, the armature was not
@@ -78,24 +85,39 @@ class SkinPlan:
     armature's own, or tails derived from the joints where its bones are
     point-like (``core.skeleton.tails.with_reliable_tails``; the armature
     itself is never changed). ``tail_decision`` says which and why.
+
+    Attributes
+    ----------
+    armature : bpy.types.Object
+    meshes : list of bpy.types.Object, the meshes skinned together
+    mesh : Mesh of ``meshes`` (None when there are none)
+    skeleton : Skeleton
+    settings : SkinSettings
+    tail_decision : TailDecision
+    strays : (n,) bool array over ``mesh``'s vertices, far strays left out of
+        the computation and weighted like their nearest kept vertex
+        (``core.geometry.outliers``), or None
+    solved : Mesh the weights are computed on: ``mesh`` without ``strays``
+    rigid : list of RigidBinding, props bound wholly to the bone they were parented to
+    notes : list of str, what the report adds about them, linked duplicates and props left rigid
     """
 
     armature: object
     meshes: list
-    mesh: Mesh
+    mesh: Mesh | None
     skeleton: Skeleton
     settings: SkinSettings
     tail_decision: TailDecision = TailDecision()
+    strays: np.ndarray | None = None
+    solved: Mesh | None = None
+    rigid: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
 
     @property
     def summary(self) -> str:
-        """What the report adds to "Skinned ...": the derived tails, if any."""
-        return f" ({self.tail_decision.note})" if self.tail_decision.any_derived else ""
-
-
-def _check_in_object_mode(obj) -> None:
-    if obj.mode != "OBJECT":
-        raise InputError(f"'{obj.name}' is in {obj.mode.replace('_', ' ').title()} Mode: leave it first.")
+        """What the report adds to "Skinned ...": the derived tails, if any, and the notes."""
+        text = f" ({self.tail_decision.note})" if self.tail_decision.any_derived else ""
+        return text + "".join(f"; {note}" for note in self.notes)
 
 
 def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str) -> None:
@@ -110,47 +132,88 @@ def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str
         )
 
 
-def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph) -> SkinPlan:
-    """Read and check the inputs; raises :class:`InputError` on bad input."""
+def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True) -> SkinPlan:
+    """Read and check the inputs; raises :class:`InputError` on bad input.
+
+    Parameters
+    ----------
+    armature : bpy.types.Object
+    meshes : list of bpy.types.Object
+    settings : SkinSettings
+    depsgraph : bpy.types.Depsgraph
+    named : bool
+        True when the user named or selected ``meshes``; False when the run
+        picked them itself (every mesh of a file): helper objects are then
+        left out and props on a bone left rigid.
+    """
     convert.require_armature_object(armature)
+    meshes = list(dict.fromkeys(meshes))
+    if not named:
+        meshes = without_helpers(meshes)
     if not meshes:
         raise InputError("Select the mesh(es) to skin together with the armature.")
-    for obj in [armature, *meshes]:
-        _check_in_object_mode(obj)
+    check_mode(armature, "skin")
     for obj in meshes:
         convert.require_mesh_object(obj, "mesh to skin")
+        check_mode(obj, "skin")
     skeleton = convert.read_skeleton(armature)
     if not skeleton.deform.any():
         raise InputError(f"The armature '{armature.name}' has no deform bones: enable Deform on the bones to weight.")
+    meshes, rigid, left_rigid = split_bone_parented(meshes, armature, named)
+    # Named props left rigid sit on a bone that does not deform.
+    notes = [f"'{obj.name}' {left_rigid_note(obj)}" + (" (it does not deform)" if named else "") for obj in left_rigid]
+    notes += [f"'{binding.obj.name}' {binding.note}" for binding in rigid]
+    if not meshes and not rigid:
+        raise InputError(f"Nothing to skin: {'; '.join(notes)}.")
+    notes += [f"'{obj.name}' {note}" for obj, note in shared_mesh_notes(meshes + [b.obj for b in rigid]).items()]
+    if not meshes:
+        return SkinPlan(armature, [], None, skeleton, settings, rigid=rigid, notes=notes)
     mesh = convert.read_mesh(meshes, depsgraph)
-    if not np.all(np.isfinite(mesh.vertices)):
-        raise InputError("A mesh has NaN or infinite vertex positions.")
-    if mesh.bounding_box_diagonal <= 0:
+    require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
+    solved, strays = split_strays(mesh)
+    if solved.bounding_box_diagonal <= 0:
         raise InputError("The mesh has zero size.")
+    if strays is not None:
+        notes += [f"'{name}': {note}" for name, note in stray_notes(mesh, strays, "the distances").items()]
     # Point-like bones (glTF imports of scaled armatures) get tails derived
     # from the joints; a zero-length deform bone with no child is refused.
-    skeleton, tail_decision = with_reliable_tails(skeleton, mesh.bounding_box_diagonal)
-    _check_skeleton_fits_mesh(skeleton.deform_subset(), mesh, armature.name)
-    return SkinPlan(armature, list(meshes), mesh, skeleton, settings, tail_decision)
+    skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)
+    _check_skeleton_fits_mesh(skeleton.deform_subset(), solved, armature.name)
+    return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes)
 
 
 def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> Weights:
-    """(n, deform bones) weights for every vertex of every mesh; no ``bpy``."""
+    """(n, deform bones) weights for every vertex of every mesh; no ``bpy``.
+    Far strays are left out of the computation and take the weights of the
+    nearest kept vertex (``core.geometry.outliers.rows_for_strays``)."""
     s = plan.settings
-    return skinning.geometric_weights(
-        plan.mesh, plan.skeleton, method=s.distance, resolution=int(s.resolution), falloff=float(s.falloff),
+    if plan.mesh is None:
+        names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
+        return Weights(np.zeros((0, len(names))), names)
+    weights = skinning.geometric_weights(
+        plan.solved, plan.skeleton, method=s.distance, resolution=int(s.resolution), falloff=float(s.falloff),
         max_influences=int(s.max_influences), smoothing_iterations=int(s.smoothing_iterations),
         smoothing_strength=float(s.smoothing_strength), progress=progress,
     )
+    if plan.strays is None:
+        return weights
+    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, plan.strays)
+    return Weights(rows, weights.bone_names)
 
 
 def write_skin(plan: SkinPlan, weights: Weights) -> None:
-    """Write each mesh's rows; on any failure every mesh is restored."""
-    with restored_on_failure(plan.meshes):
+    """Write each mesh's rows and bind the props on a bone to it; on any
+    failure every object is restored. Linked duplicates get their own mesh
+    first."""
+    with restored_on_failure(plan.meshes + [binding.obj for binding in plan.rigid]):
         for index, obj in enumerate(plan.meshes):
+            give_own_mesh(obj)
             rows = plan.mesh.object_slice(index)
             write_weights(obj, Weights(weights.matrix[rows], weights.bone_names), plan.armature,
                           replace_all=plan.settings.replace_all)
+        for binding in plan.rigid:
+            give_own_mesh(binding.obj)
+            bind_to_bone(binding.obj, binding.armature, binding.bone, binding.rest_world)
 
 
 def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
@@ -232,7 +295,7 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.mode == "OBJECT"
+        return mode_poll(cls, context, cls.bl_label)
 
     def invoke(self, context, event):
         settings = context.scene.autorig

@@ -7,6 +7,10 @@ The work is split so nothing is written before everything is computed:
 3. :func:`write_transfer` writes all targets, restoring every one of them
    if any write fails.
 
+Props parented to a bone, helper objects, linked duplicates and stray
+vertices: :mod:`..object_roles` and :mod:`autorig_addon.core.geometry.outliers`;
+each target's line of the report says what happened to it.
+
 The command line (``autorig_addon.cli.transfer``) calls the same three
 functions. What each exception means: :mod:`autorig_addon.core.errors`.
 """
@@ -29,15 +33,27 @@ from ...core.transfer.combine import (
     needs_existing_weights,
 )
 from ...core.transfer.options import GROUP_MEMBER_THRESHOLD, TransferOptions
-from ...core.transfer.transfer import transfer_weights
+from ...core.messages import listed_names
+from ...core.geometry.outliers import require_finite_positions, rows_for_strays
+from ...core.transfer.transfer import VertexStatus, check_source_weights, transfer_weights
 from ...core.types import Mesh, Weights
 from ...core.weights import normalize_rows
 from .. import convert
+from ..object_roles import (
+    RigidBinding,
+    bone_parent,
+    give_own_mesh,
+    left_rigid_note,
+    shared_mesh_notes,
+    split_bone_parented,
+    without_helpers,
+)
 from ..progress import blender_progress
 from ..snapshot import restored_on_failure
 from ..status_attribute import write_status_attribute
 from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties
-from ..weight_writer import write_weights
+from ..weight_writer import bind_to_bone, write_weights
+from .input_checks import check_mode, mode_poll, split_strays, stray_notes
 
 
 @dataclass(frozen=True)
@@ -74,9 +90,13 @@ class TransferPlan:
     armature : bpy.types.Object (armature deforming the source)
     bone_names : tuple of b str, the source's deform bones, column order
     transferred_bones : tuple of str, the subset whose weights are written
-    source_mesh : Mesh
-    source_weights : Weights (n_source, b), rows normalised
+    source_mesh : Mesh, without far stray vertices (``core.geometry.outliers``)
+    source_weights : Weights (n_source, b), raw as stored (the core skips unusable rows)
     settings : TransferSettings
+    rigid : list of RigidBinding, props on a bone bound wholly to it instead
+    left_rigid : list of bpy.types.Object, props on a bone left as they are
+    notes : dict object -> list of str, what each target's report line adds
+        (its own mesh for a linked duplicate, strays of the source)
     """
 
     source: object
@@ -87,6 +107,9 @@ class TransferPlan:
     source_mesh: Mesh
     source_weights: Weights
     settings: TransferSettings
+    rigid: list = field(default_factory=list)
+    left_rigid: list = field(default_factory=list)
+    notes: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -96,16 +119,19 @@ class TargetOutcome:
     Attributes
     ----------
     target : bpy.types.Object
-    weights : Weights (n_target, b), the final weights to write
-    status : (n_target,) int8 array of ``VertexStatus``
+    weights : Weights (n_target, b), the final weights to write, or None
+        for a prop left rigid on its bone (nothing is written)
+    status : (n_target,) int8 array of ``VertexStatus``, or None (no status colours)
     summary : str
+    rigid : RigidBinding or None, for a prop bound wholly to its bone
     """
 
     target: object
-    weights: Weights
-    status: np.ndarray
+    weights: Weights | None
+    status: np.ndarray | None
     summary: str
     timings: dict = field(default_factory=dict)
+    rigid: RigidBinding | None = None
 
 
 # --------------------------------------------------------------------------- object lookup
@@ -134,9 +160,35 @@ def _is_skinned_mesh(obj) -> bool:
     return True
 
 
-def resolve_source(context, name: str):
+@dataclass(frozen=True)
+class HowToPick:
+    """How refusals tell the user to name the source and the targets, which
+    depends on how the transfer was started.
+
+    Attributes
+    ----------
+    source : str, completes "make the body the active object or ..."
+    targets : str, completes "select the meshes to weight together with the source, or ..."
+    """
+
+    source: str
+    targets: str
+
+
+#: From the AutoRig panel's button (the operator's ``invoke``).
+PICK_IN_PANEL = HowToPick("pick it as Source in the AutoRig panel", "pick a Target in the AutoRig panel")
+#: From a script (``bpy.ops.autorig.transfer_weights(...)`` runs ``execute``
+#: alone, so the panel's Source and Target are not read).
+PICK_IN_SCRIPT = HowToPick(
+    "pass it by name (bpy.ops.autorig.transfer_weights(source='Body', ...))",
+    "pass them by name (bpy.ops.autorig.transfer_weights(targets='Shirt,Trousers', ...))",
+)
+
+
+def resolve_source(context, name: str, how: HowToPick = PICK_IN_PANEL):
     """The source object: ``name`` if given, else the active skinned mesh,
-    else the only skinned mesh among the selected objects."""
+    else the only skinned mesh among the selected objects; refusals say
+    how to name it the way ``how`` describes."""
     names = split_names(name)
     if len(names) > 1:
         raise InputError(
@@ -155,16 +207,34 @@ def resolve_source(context, name: str):
     if len(candidates) > 1:
         raise InputError(
             f"Several selected meshes are skinned ({', '.join(sorted(o.name for o in candidates))}): "
-            "make the body the active object or pick it as Source in the AutoRig panel."
+            f"make the body the active object or {how.source}."
         )
     if not candidates:
-        raise InputError("No source: pick the skinned body as Source in the AutoRig panel (or make it the active object).")
+        raise InputError(f"No source: make the skinned body the active object or {how.source}.")
     return candidates[0]
 
 
-def resolve_targets(context, names: str, source, extra=None) -> list:
+def unbound_meshes(source) -> list:
+    """The meshes a run weights when none is named: every mesh of the file
+    other than ``source`` not yet deformed by an armature (through a modifier
+    or as an armature's object child). Props on a bone are included:
+    :func:`plan_transfer` with ``named=False`` leaves them rigid and says so,
+    and leaves out helper objects."""
+    meshes = []
+    for obj in bpy.data.objects:
+        if obj.type != "MESH" or obj == source:
+            continue
+        modifier_bound = any(m.type == "ARMATURE" and m.object is not None for m in obj.modifiers)
+        child_bound = obj.parent is not None and obj.parent.type == "ARMATURE" and bone_parent(obj) is None
+        if not (modifier_bound or child_bound):
+            meshes.append(obj)
+    return meshes
+
+
+def resolve_targets(context, names: str, source, extra=None, how: HowToPick = PICK_IN_PANEL) -> list:
     """Target objects: the comma-separated ``names``, or when empty the
-    selected meshes other than ``source`` plus ``extra`` (may be None)."""
+    selected meshes other than ``source`` plus ``extra`` (may be None);
+    a refusal says how to name them the way ``how`` describes."""
     if split_names(names):
         targets = [_object_named(name) for name in split_names(names)]
     else:
@@ -173,19 +243,11 @@ def resolve_targets(context, names: str, source, extra=None) -> list:
             targets.append(extra)
     unique = list(dict.fromkeys(targets))
     if not unique:
-        raise InputError(
-            "No target: select the meshes to weight together with the source, "
-            "or pick a Target in the AutoRig panel."
-        )
+        raise InputError(f"No target: select the meshes to weight together with the source, or {how.targets}.")
     return unique
 
 
 # --------------------------------------------------------------------------- plan / compute / write
-
-
-def _check_not_in_edit_mode(obj) -> None:
-    if obj.mode == "EDIT":
-        raise InputError(f"'{obj.name}' is in Edit Mode: switch to Object Mode so its edits are saved, then transfer.")
 
 
 def _transferred_bones(settings: TransferSettings, bone_names: tuple, armature) -> tuple:
@@ -203,7 +265,7 @@ def _transferred_bones(settings: TransferSettings, bone_names: tuple, armature) 
     return requested
 
 
-def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) -> TransferPlan:
+def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, *, named: bool = True) -> TransferPlan:
     """Check the objects and read the source.
 
     Parameters
@@ -212,47 +274,117 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph) 
     targets : list of bpy.types.Object, meshes to weight
     settings : TransferSettings
     depsgraph : bpy.types.Depsgraph
+    named : bool
+        True when the user named or selected ``targets``; False when the run
+        picked them itself (:func:`unbound_meshes`): helper objects are then
+        left out and props on a bone left rigid.
 
     Raises
     ------
     InputError for: a non-mesh source or target, the source among the
-    targets, objects in Edit Mode, a source with no armature or no weights
-    on its deform bones, unknown bones, bad settings.
+    targets, objects in Edit or Sculpt Mode, a source with no armature or
+    no weights on its deform bones, vertices at infinite positions, a prop
+    parented to a bone of another armature, unknown bones, bad settings.
     """
     check_write_mode(settings.replace_mode, settings.mix_factor)
     convert.require_mesh_object(source, "source")
-    _check_not_in_edit_mode(source)
+    check_mode(source, "transfer")
+    targets = list(dict.fromkeys(targets))
+    if not named:
+        targets = without_helpers(targets)
     for target in targets:
         convert.require_mesh_object(target, "target")
         if target == source:
             raise InputError(f"'{source.name}' is both the source and a target: pick a different mesh to weight.")
-        _check_not_in_edit_mode(target)
+        check_mode(target, "transfer")
     armature = convert.find_armature(source)
     bone_names = convert.deform_bone_names(armature)
     if not bone_names:
         raise InputError(f"The armature '{armature.name}' has no bones with Deform enabled.")
+    targets, rigid, left_rigid = split_bone_parented(targets, armature, named)
+    if not targets and not rigid:
+        if not left_rigid:
+            raise InputError("Nothing to weight: the other meshes are helpers (bone shapes, hidden from render). "
+                             "Name the meshes to weight them.")
+        props = listed_names([f"'{obj.name}' (bone '{bone_parent(obj)}')" for obj in left_rigid])
+        one = len(left_rigid) == 1
+        raise InputError(f"Nothing to weight: {props} {'is' if one else 'are'} left rigid on "
+                         f"{'its bone' if one else 'their bones'}. Name the meshes to weight them.")
     source_weights = convert.read_weights(source, bone_names)
-    if not np.any(source_weights.matrix > 0):
+    # NaN weights (which vertex groups can hold) are not a naming problem:
+    # the core's check_source_weights says what is wrong with them.
+    if not np.any(source_weights.matrix > 0) and not np.isnan(source_weights.matrix).any():
         raise InputError(
             f"'{source.name}' has no weights for the deform bones of '{armature.name}': "
             "its vertex groups must be named after the bones. Skin it first."
         )
     source_mesh = convert.read_mesh([source], depsgraph)
+    require_finite_positions(source_mesh.vertices, source_mesh.object_names, source_mesh.object_offsets)
+    check_source_weights(source_mesh, source_weights)
+    kept_source, source_strays = split_strays(source_mesh)
+    notes = {obj: [note] for obj, note in shared_mesh_notes(targets + [b.obj for b in rigid]).items()}
+    if source_strays is not None:
+        (source_note,) = stray_notes(source_mesh, source_strays, "the matching").values()
+        for target in targets:
+            notes.setdefault(target, []).append(f"source '{source.name}': {source_note}")
+        source_weights = Weights(source_weights.matrix[~source_strays], bone_names)
+        source_mesh = kept_source
     return TransferPlan(
         source=source,
-        targets=list(targets),
+        targets=targets,
         armature=armature,
         bone_names=bone_names,
         transferred_bones=_transferred_bones(settings, bone_names, armature),
         source_mesh=source_mesh,
-        source_weights=Weights(normalize_rows(source_weights.matrix), bone_names),
+        # Raw: the core never copies rows without usable weights (none, NaN) and reports them.
+        source_weights=source_weights,
         settings=settings,
+        rigid=rigid,
+        left_rigid=left_rigid,
+        notes=notes,
     )
+
+
+def _transfer_without_strays(plan: TransferPlan, target_mesh: Mesh, inpaint_mask, protected, existing: Weights,
+                             progress: ProgressCallback | None):
+    """The core transfer onto ``target_mesh`` with its far strays left out:
+    (weights (n, b) in ``plan.bone_names`` order, status (n,), summary, timings,
+    stray mask or None). Strays take the weights of their nearest kept vertex
+    (protected strays keep theirs) and the status of a part with no match."""
+    kept_mesh, strays = split_strays(target_mesh)
+    keep = slice(None) if strays is None else ~strays
+
+    def subset(mask):
+        return None if mask is None else mask[keep]
+
+    result = transfer_weights(
+        plan.source_mesh,
+        plan.source_weights,
+        kept_mesh,
+        plan.settings.options,
+        inpaint_mask=subset(inpaint_mask),
+        protected=subset(protected),
+        protected_weights=Weights(existing.matrix[keep], existing.bone_names) if protected is not None else None,
+        progress=progress,
+    )
+    same_order = result.weights.bone_names == plan.bone_names
+    incoming = result.weights.matrix if same_order else result.weights.select_bones(plan.bone_names).matrix
+    status = np.asarray(result.status)
+    if strays is not None:
+        incoming = rows_for_strays(incoming, target_mesh.vertices, target_mesh.triangles, strays)
+        if protected is not None:
+            kept_rows = strays & protected
+            incoming[kept_rows] = normalize_rows(existing.matrix[kept_rows])
+        full_status = np.full(len(strays), VertexStatus.UNMATCHED_PART, dtype=status.dtype)
+        full_status[~strays] = status
+        status = full_status
+    return incoming, status, result.summary(), dict(result.timings), strays
 
 
 def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallback | None) -> TargetOutcome:
     settings = plan.settings
     target_mesh = convert.read_mesh([target], depsgraph)
+    require_finite_positions(target_mesh.vertices, target_mesh.object_names, target_mesh.object_offsets)
     inpaint_mask = convert.vertex_group_mask(target, settings.mask_group, GROUP_MEMBER_THRESHOLD)
     protected = convert.vertex_group_mask(target, settings.protect_group, GROUP_MEMBER_THRESHOLD)
     reads_existing = protected is not None or needs_existing_weights(
@@ -261,44 +393,53 @@ def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallba
         existing = convert.read_weights(target, plan.bone_names)
     else:
         existing = Weights(np.zeros((len(target.data.vertices), len(plan.bone_names))), plan.bone_names)
-    result = transfer_weights(
-        plan.source_mesh,
-        plan.source_weights,
-        target_mesh,
-        settings.options,
-        inpaint_mask=inpaint_mask,
-        protected=protected,
-        protected_weights=existing if protected is not None else None,
-        progress=progress,
-    )
-    same_order = result.weights.bone_names == plan.bone_names
-    incoming = result.weights.matrix if same_order else result.weights.select_bones(plan.bone_names).matrix
+    incoming, status, summary, timings, strays = _transfer_without_strays(
+        plan, target_mesh, inpaint_mask, protected, existing, progress)
     column_of = {name: k for k, name in enumerate(plan.bone_names)}
     columns = np.array([column_of[name] for name in plan.transferred_bones], dtype=np.int64)
     final = combine_with_existing(existing.matrix, incoming, columns, settings.replace_mode, settings.mix_factor,
                                   settings.options.max_influences)
-    return TargetOutcome(target, Weights(final, plan.bone_names), np.asarray(result.status), result.summary(), dict(result.timings))
+    notes = list(plan.notes.get(target, []))
+    if strays is not None:
+        notes += list(stray_notes(target_mesh, strays, "the transfer").values())
+    summary += "".join(f"; {note}" for note in notes)
+    return TargetOutcome(target, Weights(final, plan.bone_names), status, summary, timings)
 
 
 def compute_transfer(plan: TransferPlan, depsgraph, progress: ProgressCallback | None = None) -> list[TargetOutcome]:
-    """Run the core transfer for every target of ``plan``; writes nothing."""
+    """Run the core transfer for every target of ``plan``; writes nothing.
+    Props on a bone get an outcome saying what happens to them (bound
+    wholly to it, or left rigid) and no transfer."""
     outcomes = []
     count = len(plan.targets)
     for index, target in enumerate(plan.targets):
         report(progress, index / count, f"Weighting '{target.name}'")
         outcomes.append(_compute_one(plan, target, depsgraph, sub_progress(progress, index / count, (index + 1) / count)))
+    for binding in plan.rigid:
+        summary = binding.note + "".join(f"; {note}" for note in plan.notes.get(binding.obj, []))
+        outcomes.append(TargetOutcome(binding.obj, None, None, summary, rigid=binding))
+    for obj in plan.left_rigid:
+        outcomes.append(TargetOutcome(obj, None, None, left_rigid_note(obj)))
     report(progress, 1.0, "Done")
     return outcomes
 
 
 def write_transfer(plan: TransferPlan, outcomes: list[TargetOutcome]) -> None:
-    """Write weights, binding and status colours of every outcome.
+    """Write weights, binding and status colours of every outcome (a prop
+    bound to its bone gets that bone's group and no status colours; one left
+    rigid is not touched). Linked duplicates get their own mesh first.
 
     All-or-nothing over all targets: if any write fails, every target is
     restored and the exception re-raised.
     """
-    with restored_on_failure([outcome.target for outcome in outcomes]):
-        for outcome in outcomes:
+    written = [outcome for outcome in outcomes if outcome.weights is not None or outcome.rigid is not None]
+    with restored_on_failure([outcome.target for outcome in written]):
+        for outcome in written:
+            give_own_mesh(outcome.target)
+            if outcome.rigid is not None:
+                binding = outcome.rigid
+                bind_to_bone(binding.obj, binding.armature, binding.bone, binding.rest_world)
+                continue
             write_weights(
                 outcome.target, outcome.weights, plan.armature,
                 replace_all=plan.settings.replace_mode == REPLACE_ALL,
@@ -312,9 +453,11 @@ def outcome_report(outcomes: list[TargetOutcome]) -> str:
     return "; ".join(f"{outcome.target.name}: {outcome.summary}" for outcome in outcomes)
 
 
-def run_transfer(source, targets: list, settings: TransferSettings, depsgraph, progress: ProgressCallback | None = None) -> list[TargetOutcome]:
-    """Plan, compute and write a transfer; nothing is written on error."""
-    plan = plan_transfer(source, targets, settings, depsgraph)
+def run_transfer(source, targets: list, settings: TransferSettings, depsgraph, progress: ProgressCallback | None = None,
+                 *, named: bool = True) -> list[TargetOutcome]:
+    """Plan, compute and write a transfer; nothing is written on error.
+    ``named``: see :func:`plan_transfer`."""
+    plan = plan_transfer(source, targets, settings, depsgraph, named=named)
     outcomes = compute_transfer(plan, depsgraph, progress)
     write_transfer(plan, outcomes)
     return outcomes
@@ -392,12 +535,12 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and context.view_layer is not None
+        return context.scene is not None and context.view_layer is not None and mode_poll(cls, context, cls.bl_label)
 
     def invoke(self, context, event):
         for name, value in scene_defaults(context, self.properties.is_property_set).items():
             setattr(self, name, value)
-        return self.execute(context)
+        return self._run(context, PICK_IN_PANEL)
 
     def _settings(self, armature) -> TransferSettings:
         if split_names(self.bones):
@@ -414,6 +557,7 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             smoothing_iterations=self.smoothing_iterations,
             smoothing_strength=self.smoothing_strength,
             max_influences=self.max_influences,
+            allow_poor_match=self.allow_poor_match,
         )
         return TransferSettings(
             options=options,
@@ -425,9 +569,14 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
         )
 
     def execute(self, context):
+        return self._run(context, PICK_IN_SCRIPT)
+
+    def _run(self, context, how: HowToPick):
+        """Transfer with the operator's properties; ``how`` words the refusals
+        for the way it was started (panel button or script)."""
         try:
-            source = resolve_source(context, self.source)
-            targets = resolve_targets(context, self.targets, source)
+            source = resolve_source(context, self.source, how)
+            targets = resolve_targets(context, self.targets, source, how=how)
             depsgraph = context.evaluated_depsgraph_get()
             settings = self._settings(convert.find_armature(source))
             with blender_progress(context, "Transfer weights") as progress:
@@ -486,7 +635,7 @@ class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
         try:
             obj = self._target(context)
             name = self._group_name(context)
-            _check_not_in_edit_mode(obj)
+            check_mode(obj, "transfer")
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

@@ -79,6 +79,7 @@ class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
             column.prop(settings, "distance_fraction")
         column.prop(settings, "max_normal_angle")
         column.prop(settings, "accept_flipped_normals")
+        column.prop(settings, "allow_poor_match")
 
         column = layout.column(align=True)
         column.prop(settings, "smoothing_iterations")

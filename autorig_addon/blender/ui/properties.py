@@ -107,6 +107,12 @@ class TransferOptionProperties:
         max=MAX_INFLUENCES,
         default=transfer_options.DEFAULT_MAX_INFLUENCES,
     )
+    allow_poor_match: BoolProperty(
+        name="Allow Poor Match",
+        description="Transfer even when almost nothing matches, another unit scale fits much better, or matches "
+        "are far from the body (otherwise refused: usually a unit mix-up or a garment off the body)",
+        default=transfer_options.DEFAULT_ALLOW_POOR_MATCH,
+    )
     mask_group: StringProperty(
         name="Inpaint Mask",
         description="Vertex group on the target whose vertices (weight "

@@ -34,6 +34,7 @@ from ..types import Mesh
 from .cell_graph import BoneGraph
 from .grid import DEFAULT_RESOLUTION, VoxelGrid
 from .interior import fill_interior
+from .memory_estimate import HOLLOW_MEMORY, VoxelMemory, check_voxel_memory
 from .surface_voxels import voxelize_surface
 from .vertex_distances import fill_unreached, vertex_distances_on_graph
 
@@ -86,6 +87,7 @@ def bone_distances(
     *,
     resolution: int = DEFAULT_RESOLUTION,
     grid: VoxelGrid | None = None,
+    memory: VoxelMemory = HOLLOW_MEMORY,
     progress: ProgressCallback | None = None,
 ) -> np.ndarray:
     """Distance from each vertex to each bone along the paths of one distance kind.
@@ -102,6 +104,9 @@ def bone_distances(
         A grid of this mesh already voxelised and filled
         (``fill_interior(voxelize_covering_bones(...))``), to share it between
         distance kinds; ``resolution`` is then ignored.
+    memory : VoxelMemory, the kind's memory model: a ``resolution`` whose
+        estimated peak exceeds the free memory is refused before any cell is
+        allocated (:func:`.memory_estimate.check_voxel_memory`)
     progress : optional ProgressCallback
 
     Returns
@@ -111,6 +116,7 @@ def bone_distances(
     """
     heads, tails = validate_bones(heads, tails)
     if grid is None:
+        check_voxel_memory(mesh, heads, tails, resolution, memory)
         grid = fill_interior(voxelize_covering_bones(mesh, heads, tails, resolution, sub_progress(progress, 0.0, 0.15)))
     report(progress, 0.2, "Building the path graph")
     graph = build_graph(grid, heads, tails)

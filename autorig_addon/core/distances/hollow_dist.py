@@ -63,6 +63,7 @@ from ..types import Mesh
 from .bone_distances import bone_distances, validate_bones
 from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, layer_cost_above, merge_cells, neighbour_node_pairs
 from .grid import DEFAULT_RESOLUTION, NEIGHBOUR_OFFSETS, VoxelGrid, segment_cells
+from .memory_estimate import HOLLOW_MEMORY
 from .line_of_sight import refine_in_sight
 
 #: A straight segment from a vertex to a bone counts as a hollow path when,
@@ -96,7 +97,7 @@ def hollow_distances(
     (n, b) float64 array of distances in scene units, all finite.
     """
     return bone_distances(mesh, heads, tails, build_hollow_graph, refine_hollow_in_sight,
-                          resolution=resolution, grid=grid, progress=progress)
+                          resolution=resolution, grid=grid, memory=HOLLOW_MEMORY, progress=progress)
 
 
 def build_hollow_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) -> BoneGraph:

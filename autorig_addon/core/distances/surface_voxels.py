@@ -63,6 +63,36 @@ def voxelize_surface(
     -------
     VoxelGrid with ``surface`` set and ``inside`` all False.
     """
+    origin, cell_size, shape = grid_frame(mesh, resolution, padding_cells, cover_points)
+    surface = np.zeros(shape, dtype=bool)
+    grid = VoxelGrid(origin, cell_size, shape, surface, np.zeros(shape, dtype=bool))
+    _mark_triangle_cells(grid, mesh.vertices, mesh.triangles, progress)
+    return grid
+
+
+def grid_frame(
+    mesh: Mesh,
+    resolution: int = DEFAULT_RESOLUTION,
+    padding_cells: int = DEFAULT_PADDING_CELLS,
+    cover_points: np.ndarray | None = None,
+) -> tuple[np.ndarray, float, tuple]:
+    """Where :func:`voxelize_surface` puts its grid, without voxelising.
+
+    Parameters
+    ----------
+    as for :func:`voxelize_surface`
+
+    Returns
+    -------
+    origin : (3,) float64 array, world position of cell (0, 0, 0)'s lowest corner
+    cell_size : float, scene units
+    shape : (3,) int tuple, cells along x, y, z
+
+    Raises
+    ------
+    InputError for a mesh without faces, at one point or with non-finite
+    vertices, or a resolution or padding out of bounds.
+    """
     if not len(mesh.triangles):
         raise InputError("The mesh has no faces; voxelisation needs a surface.")
     if not MIN_RESOLUTION <= int(resolution) <= MAX_RESOLUTION:
@@ -89,10 +119,7 @@ def voxelize_surface(
     slack = core_cells * cell_size - extent
     origin = low - padding_cells * cell_size - 0.5 * slack
     shape = tuple(int(n) for n in core_cells + 2 * padding_cells)
-    surface = np.zeros(shape, dtype=bool)
-    grid = VoxelGrid(origin, cell_size, shape, surface, np.zeros(shape, dtype=bool))
-    _mark_triangle_cells(grid, mesh.vertices, mesh.triangles, progress)
-    return grid
+    return origin, cell_size, shape
 
 
 def _mark_triangle_cells(grid: VoxelGrid, V: np.ndarray, F: np.ndarray, progress: ProgressCallback | None) -> None:

@@ -49,6 +49,7 @@ from ..types import Mesh
 from .bone_distances import bone_distances, validate_bones
 from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, merge_cells, neighbour_node_pairs
 from .grid import DEFAULT_RESOLUTION, VoxelGrid, segment_cells
+from .memory_estimate import GEODESIC_MEMORY
 from .line_of_sight import refine_in_sight
 
 #: A jump through the air from a bone to a solid part it does not cross
@@ -81,7 +82,7 @@ def volumetric_geodesic_distances(
     (n, b) float64 array of distances in scene units, all finite.
     """
     return bone_distances(mesh, heads, tails, build_geodesic_graph, refine_geodesic_in_sight,
-                          resolution=resolution, grid=grid, progress=progress)
+                          resolution=resolution, grid=grid, memory=GEODESIC_MEMORY, progress=progress)
 
 
 def refine_geodesic_in_sight(

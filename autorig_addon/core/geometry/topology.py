@@ -21,7 +21,14 @@ def triangle_edges(F: np.ndarray) -> np.ndarray:
 
 def edges(F: np.ndarray) -> np.ndarray:
     """(e, 2) int64 unique undirected edges, smaller index first, sorted."""
-    return np.unique(triangle_edges(F), axis=0)
+    pairs = triangle_edges(np.asarray(F, dtype=np.int64))
+    if not len(pairs):
+        return pairs.reshape(0, 2)
+    # One int64 key per edge sorts as the rows do, and a 1-D unique is many
+    # times faster than unique(axis=0) (which sorts structured rows).
+    width = int(pairs.max()) + 1
+    keys = np.unique(pairs[:, 0] * width + pairs[:, 1])
+    return np.stack([keys // width, keys % width], axis=1)
 
 
 def non_manifold_edge_count(F: np.ndarray) -> int:

@@ -19,6 +19,13 @@ derives tails again.
 
 Vertices whose weights are all zero get no ``skin`` line; pass
 ``vertex_count`` to :func:`read_rignet_rig` to restore such trailing rows.
+
+Reading refuses, with the line at fault, what would build a broken
+armature or exhaust memory: files that are not UTF-8 text (a ``.glb``
+picked by mistake), joints beyond :data:`MAX_JOINT_COORDINATE` (a float32
+armature cannot keep its bones' lengths there), a joint at its parent's
+position (a bone with no length or direction), vertex indices no mesh can
+have, and weight tables larger than the free memory.
 """
 
 from __future__ import annotations
@@ -30,6 +37,8 @@ from typing import Optional, Union
 import numpy as np
 
 from ..errors import InputError
+from ..memory import require_memory
+from ..skeleton.checks import MIN_BONE_LENGTH_FRACTION
 from ..skeleton.hierarchy import parents_first_order, reindexed_parents
 from ..types import Skeleton, Weights
 
@@ -45,6 +54,16 @@ ROOT_FIELD_COUNT = 2
 HIERARCHY_FIELD_COUNT = 3
 #: A skin record has the keyword, the vertex index and at least one name-weight pair.
 SKIN_MIN_FIELD_COUNT = 4
+#: Largest joint coordinate accepted, scene units: Blender keeps positions in
+#: float32, which beyond this spaces them more than 0.06 apart, and no
+#: character is a thousand kilometres (or, in millimetres, a kilometre) tall.
+MAX_JOINT_COORDINATE = 1e6
+#: Largest vertex index a mesh can have: Blender counts vertices in 32-bit signed integers.
+MAX_VERTEX_INDEX = 2**31 - 2
+#: First bytes of a binary glTF file (``.glb``), the likeliest wrong pick in the file browser.
+GLB_MAGIC = b"glTF"
+#: Bytes of one weight in the dense table :func:`read_rignet_rig` builds (float64).
+WEIGHT_BYTES = 8
 
 PathOrText = Union[str, "os.PathLike[str]"]
 
@@ -74,13 +93,17 @@ def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None
     Raises
     ------
     InputError
-        Malformed lines (with their line number), unknown joint names,
-        duplicated joints or vertices, a joint with two parents, a cycle in
-        the hierarchy, or not exactly one root.
+        A file that is not UTF-8 text, malformed lines (with their line
+        number), joints beyond :data:`MAX_JOINT_COORDINATE` or at their
+        parent's position, unknown joint names, duplicated joints or
+        vertices, a joint with two parents, a cycle in the hierarchy, not
+        exactly one root, vertex indices beyond :data:`MAX_VERTEX_INDEX` or
+        ``vertex_count``, or a weight table larger than the free memory.
     """
     text = _text_from_path_or_text(path_or_text)
     records = _parse_records(text)
     order, parents = _sorted_hierarchy(records)
+    _check_joints_apart(records, order, parents)
     names = tuple(records.joint_names[j] for j in order)
     skeleton = Skeleton(records.joint_positions[order], parents, names)
     if not records.skin_vertices:
@@ -164,8 +187,22 @@ def _text_from_path_or_text(path_or_text: PathOrText) -> str:
     path = os.fspath(path_or_text)
     if not os.path.isfile(path):
         raise InputError(f"RigNet rig file not found: {path!r}. Check the path (or pass the file's text).")
-    with open(path, encoding="utf-8") as handle:
-        return handle.read()
+    with open(path, "rb") as handle:
+        data = handle.read()
+    name = os.path.basename(path)
+    if data.startswith(GLB_MAGIC):
+        raise InputError(
+            f"'{name}' is a binary glTF file, not a RigNet rig: import it with File > Import > glTF 2.0. "
+            "A RigNet rig is a text file of 'joints', 'root', 'hier' and 'skin' lines."
+        )
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise InputError(
+            f"'{name}' is not a RigNet rig: it is not text (byte {data[error.start]:#04x} at position "
+            f"{error.start} is not UTF-8). A RigNet rig is a text file of 'joints', 'root', 'hier' and "
+            "'skin' lines."
+        ) from None
 
 
 def _parse_records(text: str) -> _Records:
@@ -203,6 +240,12 @@ def _parse_joint(fields: list[str], line: int, records: _Records, positions: lis
         first = records.joint_lines[records.joint_index[name]]
         raise InputError(f"Line {line}: joint {name!r} is defined twice (first on line {first}).")
     position = [_finite_float(value, line, "joint coordinate") for value in fields[2:]]
+    if max(abs(value) for value in position) > MAX_JOINT_COORDINATE:
+        raise InputError(
+            f"Line {line}: joint {name!r} lies at {', '.join(f'{value:g}' for value in position)}, beyond "
+            f"{MAX_JOINT_COORDINATE:g} units from the origin: Blender cannot keep bone lengths there. "
+            "The file is damaged or in the wrong units."
+        )
     records.joint_index[name] = len(records.joint_names)
     records.joint_names.append(name)
     records.joint_lines.append(line)
@@ -240,6 +283,11 @@ def _parse_skin(fields: list[str], line: int, records: _Records) -> None:
         raise InputError(f"Line {line}: vertex index {fields[1]!r} is not an integer.") from None
     if vertex < 0:
         raise InputError(f"Line {line}: vertex index {vertex} is negative.")
+    if vertex > MAX_VERTEX_INDEX:
+        raise InputError(
+            f"Line {line}: vertex index {vertex} is larger than any mesh can have "
+            f"(Blender meshes hold at most {MAX_VERTEX_INDEX + 1} vertices); the file is damaged."
+        )
     weights = [_finite_float(value, line, "weight") for value in fields[3::2]]
     if min(weights) < 0.0:
         raise InputError(f"Line {line}: negative skin weight {min(weights)}; weights must be >= 0.")
@@ -311,6 +359,25 @@ def _sorted_hierarchy(records: _Records) -> tuple[np.ndarray, np.ndarray]:
     return order, reindexed_parents(parent_of, order)
 
 
+def _check_joints_apart(records: _Records, order: np.ndarray, parents: np.ndarray) -> None:
+    """Raise :class:`InputError` for a joint at its parent's position (within
+    ``MIN_BONE_LENGTH_FRACTION`` of the joints' extent): the bone between
+    them would have no length and no direction."""
+    joints = records.joint_positions[order]
+    extent = float(np.ptp(joints, axis=0).max()) if len(joints) else 0.0
+    children = np.flatnonzero(parents >= 0)
+    gaps = np.linalg.norm(joints[children] - joints[parents[children]], axis=1)
+    together = children[gaps <= MIN_BONE_LENGTH_FRACTION * extent]
+    if len(together):
+        child, parent = int(order[together[0]]), int(order[parents[together[0]]])
+        raise InputError(
+            f"Line {records.joint_lines[child]}: joint {records.joint_names[child]!r} is at the same position as "
+            f"its parent {records.joint_names[parent]!r} (line {records.joint_lines[parent]}), so the bone between "
+            f"them has no length or direction ({len(together)} such joint(s)). Move one of them, or remove the "
+            "duplicate and give its children to the other."
+        )
+
+
 def _check_single_root(records: _Records, parent_of: np.ndarray) -> None:
     """Raise :class:`InputError` unless exactly one joint has no parent and
     it is the one a ``root`` line names (when there is such a line)."""
@@ -353,6 +420,12 @@ def _weights_from_skin(
     largest = int(vertices.max())
     if vertex_count is None:
         vertex_count = largest + 1
+        line = records.skin_lines[int(np.argmax(vertices))]
+        require_memory(
+            float(vertex_count) * len(names) * WEIGHT_BYTES,
+            f"Line {line}: vertex index {largest} means a mesh of {vertex_count} vertices; its weight table",
+            "The file is damaged, or import it with its mesh selected so the indices are checked against it.",
+        )
     elif largest >= vertex_count:
         line = records.skin_lines[int(np.argmax(vertices))]
         raise InputError(

@@ -4,7 +4,16 @@ Stage 1 of robust weight transfer (Abdrashitov et al. 2023, section 3.1):
 each target vertex takes the source weights at its closest point on the
 source surface (barycentric interpolation, not the nearest vertex, which
 picks the wrong side of a coarse body), and counts as matched only when
-that point is near and the normals agree.
+that point is near, the normals agree and the point carries weight.
+
+Source vertices whose weights are unusable (none, or NaN, infinite or
+negative entries: :func:`~autorig_addon.core.weights.usable_rows`) never
+make a match: a target vertex whose closest point draws on them is left to
+the inpainting, and its fallback row is that of the nearest source vertex
+with usable weights, so no row is ever empty.
+
+:func:`likely_unit_factor` tells, when little matches, whether the target
+would fit the source at another unit scale (2.54, 100, ...).
 """
 
 from __future__ import annotations
@@ -12,11 +21,35 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
+from ..errors import InputError
+from ..geometry.bounding_box import bounding_box_diagonal
 from ..geometry.closest_point import SurfacePoints, TriangleMeshQuery
 from ..geometry.normals import vertex_normals
 from ..types import Mesh, Weights
-from ..weights import normalize_rows
+from ..weights import normalize_rows, usable_rows
+
+#: A closest point drawing more than this share of its (barycentric) weight
+#: from source vertices without usable weights does not count as a match.
+MAX_UNWEIGHTED_SHARE = 1e-3
+#: Scale factors a unit mix-up gives, target size over the size it should
+#: have, with the units that differ by it; each is tried with its inverse.
+UNIT_FACTORS = {
+    2.54: "inches and centimetres",
+    10.0: "millimetres and centimetres",
+    100.0: "centimetres and metres",
+    1000.0: "millimetres and metres",
+    3.28084: "feet and metres",
+    39.3701: "inches and metres",
+}
+#: Target vertices sampled when trying the unit factors (evenly spread over the vertex order).
+UNIT_FACTOR_SAMPLES = 256
+#: A unit factor is named only when, scaled by it, at least this share of the
+#: sampled target vertices lies within the match distance of the source ...
+UNIT_FACTOR_MIN_NEAR_SHARE = 0.5
+#: ... and at least this many times the share that does at the current scale.
+UNIT_FACTOR_MIN_GAIN = 2.0
 
 
 @dataclass(frozen=True)
@@ -25,23 +58,45 @@ class Matches:
 
     Attributes
     ----------
-    weights : (n, b) float64 array, source weights at the closest points
-        (rows normalised), for every vertex, matched or not
+    weights : (n, b) float64 array, rows normalised and never empty: the
+        source weights at the closest point where it carries usable weight,
+        else those of the nearest source vertex that does
     distances : (n,) float64 array, distance to the closest point, scene units
     matched : (n,) bool array, near enough with agreeing (or, where allowed,
-        opposite) normals: these weights can be copied
+        opposite) normals, on weighted source: these weights can be copied
     flipped : (n,) bool array, matched through opposite normals (a subset of ``matched``)
+    unweighted : (n,) bool array, near with agreeing normals but the closest
+        point lies on source vertices without usable weights (not matched)
     """
 
     weights: np.ndarray
     distances: np.ndarray
     matched: np.ndarray
     flipped: np.ndarray
+    unweighted: np.ndarray
 
 
-def _weights_at(surface: SurfacePoints, source: Mesh, source_weights: np.ndarray) -> np.ndarray:
-    """(q, b) ``source_weights`` interpolated at ``surface``'s points, rows normalised."""
-    return normalize_rows(surface.interpolate(source.triangles, source_weights))
+def _weights_at(surface: SurfacePoints, source: Mesh, source_weights: np.ndarray,
+                points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Source weights at ``surface``'s closest points of the (q, 3) ``points``.
+
+    Returns
+    -------
+    weights : (q, b) float64 array, rows normalised and non-empty (see :attr:`Matches.weights`)
+    weighted : (q,) bool array, the closest point carries usable weight
+    """
+    usable = usable_rows(source_weights)
+    if not usable.any():
+        raise InputError(f"The source '{source.object_names[0]}' has no vertex with usable weights.")
+    clean = np.where(usable[:, None], normalize_rows(source_weights), 0.0)
+    weights = normalize_rows(surface.interpolate(source.triangles, clean))
+    share = surface.interpolate(source.triangles, usable.astype(np.float64))
+    weighted = share >= 1.0 - MAX_UNWEIGHTED_SHARE
+    if not weighted.all():
+        candidates = np.flatnonzero(usable)
+        _, nearest = cKDTree(source.vertices[candidates]).query(points[~weighted])
+        weights[~weighted] = clean[candidates[nearest]]
+    return weights, weighted
 
 
 def closest_point_weights(source: Mesh, source_weights: Weights, target: Mesh) -> Weights:
@@ -51,28 +106,32 @@ def closest_point_weights(source: Mesh, source_weights: Weights, target: Mesh) -
     Parameters
     ----------
     source : Mesh with n_s vertices and at least one triangle
-    source_weights : Weights, (n_s, b)
+    source_weights : Weights, (n_s, b), some row usable
     target : Mesh with n vertices
 
     Returns
     -------
     Weights, (n, b), rows normalised, bones as in ``source_weights``
+    (where the closest point has no usable weight, the nearest weighted
+    source vertex's)
     """
     surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    return Weights(_weights_at(surface, source, source_weights.matrix), source_weights.bone_names)
+    weights, _ = _weights_at(surface, source, source_weights.matrix, target.vertices)
+    return Weights(weights, source_weights.bone_names)
 
 
 def match_closest_points(
     source: Mesh, source_weights: np.ndarray, target: Mesh, target_normals: np.ndarray,
     max_distance: float, max_normal_angle: float, accept_flipped_normals: bool,
 ) -> Matches:
-    """Match target vertices whose closest source point is near and whose
-    normal agrees with the source normal there.
+    """Match target vertices whose closest source point is near, carries
+    usable weight and has a normal agreeing with the target's.
 
     Parameters
     ----------
     source : Mesh with n_s vertices and at least one triangle
-    source_weights : (n_s, b) float64 array
+    source_weights : (n_s, b) float64 array, raw: rows with NaN, infinite or
+        negative entries, or no weight, never match; at least one row usable
     target : Mesh with n vertices
     target_normals : (n, 3) float64 array, unit (zero where unknown)
     max_distance : float, scene units; farther points never match
@@ -86,13 +145,102 @@ def match_closest_points(
     Matches
     """
     surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    weights = _weights_at(surface, source, source_weights)
-    source_normals = surface.interpolate(source.triangles, vertex_normals(source.vertices, source.triangles))
+    weights, weighted = _weights_at(surface, source, source_weights, target.vertices)
+    source_normals = vertex_normals(source.vertices, source.triangles)
+    candidate, flipped = _agreeing(surface, source.triangles, source_normals, target_normals, max_distance,
+                                   max_normal_angle, accept_flipped_normals)
+    return Matches(weights, surface.distances, candidate & weighted, flipped & weighted, candidate & ~weighted)
+
+
+def _agreeing(surface: SurfacePoints, source_triangles: np.ndarray, source_vertex_normals: np.ndarray,
+              target_normals: np.ndarray, max_distance: float, max_normal_angle: float,
+              accept_flipped_normals: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(q,) bool arrays: closest points near enough whose normal agrees with
+    the (q, 3) ``target_normals`` (directly or, where accepted, opposite),
+    and those that agree only through opposite normals."""
+    source_normals = surface.interpolate(source_triangles, source_vertex_normals)
     length = np.linalg.norm(source_normals, axis=1)
     cosine = np.einsum("ij,ij->i", source_normals, target_normals) / np.maximum(length, 1e-300)
     cosine[length == 0] = 0.0
     cos_limit = np.cos(np.radians(max_normal_angle))
     near = surface.distances <= max_distance
     flipped = near & (cosine <= -cos_limit) if accept_flipped_normals else np.zeros(len(near), dtype=bool)
-    matched = (near & (cosine >= cos_limit)) | flipped
-    return Matches(weights, surface.distances, matched, flipped)
+    return (near & (cosine >= cos_limit)) | flipped, flipped
+
+
+@dataclass(frozen=True)
+class UnitFactor:
+    """A unit scale at which the target would fit the source.
+
+    Attributes
+    ----------
+    factor : float, the target's size over the size it should have (> 1: too large)
+    units : str, the units that differ by this factor ("inches and centimetres")
+    near_share : float in [0, 1], share of the sampled target vertices that
+        would match (near, normals agreeing) once scaled by ``1 / factor``
+    """
+
+    factor: float
+    units: str
+    near_share: float
+
+    def describe(self, target_name: str, source_name: str) -> str:
+        """E.g. "'Skirt' looks 2.54 times too large for 'Body' (inches and
+        centimetres mixed up?): scaled by 1/2.54, 96% of it would match the body."."""
+        size = max(self.factor, 1.0 / self.factor)
+        large = self.factor > 1.0
+        scale = f"1/{size:.4g}" if large else f"{size:.4g}"
+        return (f"'{target_name}' looks {size:.4g} times too {'large' if large else 'small'} for '{source_name}' "
+                f"({self.units} mixed up?): scaled by {scale}, {100.0 * self.near_share:.0f}% of it would match "
+                "the body.")
+
+
+def likely_unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, distance_fraction: float,
+                       max_normal_angle: float, accept_flipped_normals: bool) -> UnitFactor | None:
+    """The unit factor at which ``target`` best fits ``source``, if one fits
+    much better than the current scale.
+
+    Each factor of :data:`UNIT_FACTORS` and its inverse scales a sample of
+    the target's vertices about the world origin (a file in other units)
+    and about the target's own centre (a wrong object scale); a scale fits
+    as well as the share of scaled vertices that would match: within
+    ``distance_fraction`` of the scaled target's diagonal of the source
+    surface, normals agreeing (a uniform scale keeps the normals).
+
+    Parameters
+    ----------
+    source, target : Mesh, world space, finite
+    target_normals : (n, 3) float64 array, unit normals of the target's vertices
+    distance_fraction : float > 0, match distance as a fraction of the target's diagonal
+    max_normal_angle : float, degrees; accept_flipped_normals : bool, as for :func:`match_closest_points`
+
+    Returns
+    -------
+    UnitFactor, or None when no factor reaches :data:`UNIT_FACTOR_MIN_NEAR_SHARE`
+    and :data:`UNIT_FACTOR_MIN_GAIN` times the current share.
+    """
+    picked = np.unique(np.linspace(0, target.vertex_count - 1, UNIT_FACTOR_SAMPLES).astype(np.int64))
+    sample, normals = target.vertices[picked], target_normals[picked]
+    query = TriangleMeshQuery(source.vertices, source.triangles)
+    source_normals = vertex_normals(source.vertices, source.triangles)
+    diagonal = bounding_box_diagonal(target.vertices)
+
+    def match_share(points: np.ndarray, scale: float) -> float:
+        matched, _ = _agreeing(query.closest(points), source.triangles, source_normals, normals,
+                               distance_fraction * diagonal * scale, max_normal_angle, accept_flipped_normals)
+        return float(np.mean(matched))
+
+    current = match_share(sample, 1.0)
+    if UNIT_FACTOR_MIN_GAIN * current > 1.0:
+        return None  # no scale can match twice as many
+    centre = 0.5 * (target.vertices.min(axis=0) + target.vertices.max(axis=0))
+    best = None
+    for base, units in UNIT_FACTORS.items():
+        for factor in (base, 1.0 / base):
+            for pivot in (np.zeros(3), centre):
+                share = match_share(pivot + (sample - pivot) / factor, 1.0 / factor)
+                if best is None or share > best.near_share:
+                    best = UnitFactor(factor, units, share)
+    if best.near_share >= max(UNIT_FACTOR_MIN_NEAR_SHARE, UNIT_FACTOR_MIN_GAIN * current):
+        return best
+    return None

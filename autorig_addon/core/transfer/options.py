@@ -36,6 +36,9 @@ DEFAULT_MASK_GROUP = "AutoRig Inpaint"
 #: Vertices with at least this weight in the mask or protect vertex group
 #: count as its members (weights are in [0, 1]).
 GROUP_MEMBER_THRESHOLD = 0.5
+#: By default a transfer where almost nothing matches, or where matches are
+#: far from the body, is refused (a unit mix-up or a garment off the body).
+DEFAULT_ALLOW_POOR_MATCH = False
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,9 @@ class TransferOptions:
     max_influences : int
         Keep this many largest weights per vertex (0: no limit; 4 for most
         game engines).
+    allow_poor_match : bool
+        Transfer even when almost nothing matches or matches are far from
+        the body (see ``transfer.check_match_quality``), instead of refusing.
     """
 
     distance_fraction: float = DEFAULT_DISTANCE_FRACTION
@@ -70,3 +76,4 @@ class TransferOptions:
     smoothing_iterations: int = DEFAULT_SMOOTHING_ITERATIONS
     smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
     max_influences: int = DEFAULT_MAX_INFLUENCES
+    allow_poor_match: bool = DEFAULT_ALLOW_POOR_MATCH

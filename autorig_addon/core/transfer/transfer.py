@@ -17,6 +17,13 @@ This module runs them: beyond the paper, seams are welded before inpainting
 patches); parts of the target with no match at all are seeded at their
 closest point so they move rigidly with the body; an artist mask forces
 inpainting and a protected set keeps existing weights as fixed rows.
+
+Bad input: source vertices without usable weights (none, NaN, infinite or
+negative) never make a match and the summary counts the vertices inpainted
+near them; a transfer that would mostly guess (few copies, another unit
+scale fitting much better, copies far from the body) is refused by
+:func:`check_match_quality` unless ``allow_poor_match``; and no returned row
+is ever empty or unnormalised (checked before returning).
 """
 
 from __future__ import annotations
@@ -29,18 +36,39 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry.normals import vertex_normals
+from ..geometry.outliers import require_finite_positions
 from ..geometry.smoothing import smooth_over_edges
 from ..geometry.topology import connected_component_labels, non_manifold_edge_count
 from ..geometry.weld import weld_mesh
 from ..progress import ProgressCallback, report
 from ..types import Mesh, Weights
-from ..weights import check_weights, limit_influences, normalize_rows, prune_small
+from ..weights import empty_rows, invalid_rows, limit_influences, normalize_rows, prune_small, usable_rows
 from .inpainting import inpaint_weights, inpainting_operator
-from .matching import match_closest_points
+from .matching import Matches, UnitFactor, likely_unit_factor, match_closest_points
 from .options import TransferOptions
 
 #: A target larger than this many source diagonals is taken as a unit mismatch.
 MAX_SCALE_RATIO = 5.0
+#: Unless poor matches are allowed, a transfer is refused when fewer than this
+#: share of the target's vertices (those neither masked nor protected) copy
+#: weights: the rest would be guessed by inpainting (a unit mix-up, a garment
+#: off the body, or a body weighted only elsewhere).
+MIN_COPIED_SHARE = 0.1
+#: When fewer than this share copy, the transfer is also refused if the target
+#: would fit the source much better at another unit scale
+#: (:func:`.matching.likely_unit_factor`): a garment at 2.54 times the body's
+#: scale still copies a little where it crosses the body.
+UNIT_CHECK_SHARE = 0.5
+#: Unless poor matches are allowed, a transfer is refused when the copied
+#: vertices lie farther from the source surface than this fraction of the
+#: source's bounding-box diagonal (median): a garment matched to a body it is
+#: not on, after the match distance was raised.
+MAX_MEDIAN_MATCH_FRACTION = 0.1
+#: How a refusal for a poor match tells the user to transfer anyway: the
+#: ``allow_poor_match`` option, in the panel and on the command line.
+ALLOW_POOR_MATCH_HINT = "To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line)."
+#: Largest difference from one of a written row's sum (rows are normalised in float64).
+ROW_SUM_TOLERANCE = 1e-6
 
 
 class VertexStatus(enum.IntEnum):
@@ -67,6 +95,14 @@ class TransferResult:
     timings : dict of stage name -> seconds
     welded_vertices : int, seam copies joined to another vertex before inpainting
     non_manifold_edges : int, edges shared by more than two triangles (handled, reported)
+    source_name : str, the source's (first) object, for the summary
+    unweighted_source_vertices : int, source vertices without usable weights
+        (no weight, or NaN, infinite or negative entries)
+    invalid_source_vertices : int, those of them with NaN, infinite or negative entries
+    near_unweighted : int, target vertices that would have copied weights
+        but whose closest source point has none usable: inpainted instead
+    unprotected : int, protected vertices with no weight to keep on the
+        source's bones: they were transferred instead
     """
 
     weights: Weights
@@ -75,6 +111,11 @@ class TransferResult:
     timings: dict = field(default_factory=dict)
     welded_vertices: int = 0
     non_manifold_edges: int = 0
+    source_name: str = "source"
+    unweighted_source_vertices: int = 0
+    invalid_source_vertices: int = 0
+    near_unweighted: int = 0
+    unprotected: int = 0
 
     def summary(self) -> str:
         counts = np.bincount(self.status, minlength=len(VertexStatus))
@@ -86,6 +127,13 @@ class TransferResult:
             parts.append(f"{counts[VertexStatus.PROTECTED]} protected")
         if counts[VertexStatus.UNMATCHED_PART]:
             parts.append(f"{counts[VertexStatus.UNMATCHED_PART]} on parts with no match")
+        if self.near_unweighted:
+            invalid = (f" ({self.invalid_source_vertices} with NaN, infinite or negative weights)"
+                       if self.invalid_source_vertices else "")
+            parts.append(f"{self.unweighted_source_vertices} vertices of '{self.source_name}' have no usable "
+                         f"weight{invalid}; {self.near_unweighted} vertices near them were inpainted")
+        if self.unprotected:
+            parts.append(f"{self.unprotected} protected vertices had no weight to keep and were transferred")
         if self.welded_vertices:
             parts.append(f"{self.welded_vertices} seam duplicates welded")
         if self.non_manifold_edges:
@@ -124,12 +172,19 @@ def transfer_weights(
     """
     timings: dict[str, float] = {}
     clock = time.perf_counter()
-    _check_inputs(source, source_weights, target, options)
+    source_usable = _check_inputs(source, source_weights, target, options)
     n = target.vertex_count
     inpaint_mask = _optional_mask(inpaint_mask, n, "inpaint mask")
     protected = _optional_mask(protected, n, "protected set")
     if protected.any() and protected_weights is None:
         raise InputError("Protected vertices were given without their weights.")
+    if protected.any():
+        kept = normalize_rows(protected_weights.select_bones(source_weights.bone_names).matrix)
+        # A protected vertex with nothing to keep would be written empty: transfer it.
+        unprotected = protected & empty_rows(kept)
+        protected = protected & ~unprotected
+    else:
+        unprotected = protected
 
     target_diagonal = target.bounding_box_diagonal
     max_distance = options.max_distance if options.max_distance is not None else options.distance_fraction * target_diagonal
@@ -142,18 +197,19 @@ def transfer_weights(
     report(progress, 0.05, "Matching closest points")
 
     clock = time.perf_counter()
+    welded_normals = vertex_normals(welded_V, welded_F)
     matches = match_closest_points(
-        source, source_weights.matrix, welded, vertex_normals(welded_V, welded_F),
+        source, source_weights.matrix, welded, welded_normals,
         max_distance, options.max_normal_angle, options.accept_flipped_normals,
     )
     timings["match"] = time.perf_counter() - clock
     matched = matches.matched
-    if not matched.any() and not protected.any():
-        raise InputError(
-            f"No vertex of '{target.object_names[0]}' lies within {max_distance:.4g} of the source surface "
-            "with agreeing normals: are the objects far apart or at different scales? "
-            "Apply their transforms or raise the match distance."
-        )
+    if not matched.any() and not protected.any() and not options.allow_poor_match:
+        raise InputError(_no_match_message(source, welded, welded_normals, matches, max_distance, options))
+    if not options.allow_poor_match:
+        clock = time.perf_counter()
+        check_match_quality(source, welded, welded_normals, matches, ~masked & ~protected_welded, max_distance, options)
+        timings["check"] = time.perf_counter() - clock
     report(progress, 0.35, "Building the inpainting system")
 
     clock = time.perf_counter()
@@ -164,7 +220,6 @@ def transfer_weights(
     known = matched & ~masked
     known_weights = matches.weights.copy()
     if protected.any():
-        kept = normalize_rows(protected_weights.select_bones(source_weights.bone_names).matrix)
         known_weights[protected_welded] = _mean_over_copies(kept, protected, to_welded, count)[protected_welded]
         known |= protected_welded
         status[protected_welded] = VertexStatus.PROTECTED
@@ -190,24 +245,157 @@ def transfer_weights(
     weights = solved[to_welded]
     if protected.any():
         weights[protected] = kept[protected]
+    _require_normalised_rows(weights)
+    near_unweighted = matches.unweighted[to_welded] & (status[to_welded] != VertexStatus.MASKED) & ~protected
     timings["finish"] = time.perf_counter() - clock
     report(progress, 1.0, "Done")
     return TransferResult(
         Weights(weights, source_weights.bone_names), status[to_welded], float(max_distance), timings,
         welded_vertices=n - count, non_manifold_edges=non_manifold_edge_count(welded_F),
+        source_name=source.object_names[0],
+        unweighted_source_vertices=int(np.count_nonzero(~source_usable)),
+        invalid_source_vertices=int(np.count_nonzero(invalid_rows(source_weights.matrix))),
+        near_unweighted=int(np.count_nonzero(near_unweighted)),
+        unprotected=int(np.count_nonzero(unprotected)),
     )
 
 
-def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: TransferOptions) -> None:
+def check_source_weights(source: Mesh, source_weights: Weights) -> np.ndarray:
+    """(n_source,) bool: the source vertices with usable weights
+    (:func:`~autorig_addon.core.weights.usable_rows`).
+
+    Raises
+    ------
+    InputError when the rows do not match the vertices, or no vertex has
+    usable weights (saying whether the weights are missing or corrupt).
+    """
+    name = source.object_names[0]
+    if source_weights.vertex_count != source.vertex_count:
+        raise InputError("The source weights do not have one row per source vertex.")
+    usable = usable_rows(source_weights.matrix) if source_weights.bone_names else np.zeros(source.vertex_count, bool)
+    if usable.any():
+        return usable
+    invalid = int(np.count_nonzero(invalid_rows(source_weights.matrix)))
+    if invalid:
+        raise InputError(
+            f"The source '{name}' has no usable weights: {invalid} of its {source.vertex_count} vertices have NaN, "
+            "infinite or negative weights and the others none. Clean the weights (Weights > Clean) or skin "
+            "the body again."
+        )
+    raise InputError(f"The source '{name}' carries no bone weights to transfer.")
+
+
+def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+                        eligible: np.ndarray, max_distance: float, options: TransferOptions) -> None:
+    """Refuse a transfer that would mostly guess: fewer than
+    :data:`MIN_COPIED_SHARE` of the ``eligible`` target vertices copy
+    weights, or fewer than :data:`UNIT_CHECK_SHARE` while another unit scale
+    fits much better, or the copied ones lie farther than
+    :data:`MAX_MEDIAN_MATCH_FRACTION` of the source's size from it (median).
+
+    The message gives the reason, the likely cause (:func:`poor_match_cause`)
+    and how to transfer anyway (``options.allow_poor_match``).
+
+    Parameters
+    ----------
+    source, target : Mesh (target welded, as matched)
+    target_normals : (n, 3) float64 array, unit normals of the target's vertices
+    matches : Matches of the target's vertices
+    eligible : (n,) bool array, vertices that may copy (neither masked nor protected)
+    max_distance : float, the match distance used, scene units
+    options : TransferOptions
+    """
+    candidates = int(np.count_nonzero(eligible))
+    copied = matches.matched & eligible
+    if not candidates:
+        return
+    source_name, target_name = source.object_names[0], target.object_names[0]
+    share = np.count_nonzero(copied) / candidates
+    reason = (
+        f"Only {100.0 * share:.0f}% of '{target_name}' ({np.count_nonzero(copied)} of {candidates} vertices) "
+        f"lies within {max_distance:.3g} of '{source_name}' with agreeing normals on weighted parts; "
+        "the rest would be guessed by inpainting."
+    )
+    if share < MIN_COPIED_SHARE:
+        cause = poor_match_cause(source, target, target_normals, matches, eligible, max_distance, options)
+        raise InputError(f"{reason} {cause} {ALLOW_POOR_MATCH_HINT}")
+    if share < UNIT_CHECK_SHARE:
+        factor = _unit_factor(source, target, target_normals, options)
+        if factor is not None:
+            raise InputError(f"{reason} {_unit_cause(factor, source, target)} {ALLOW_POOR_MATCH_HINT}")
+    median = float(np.median(matches.distances[copied]))
+    source_size = source.bounding_box_diagonal
+    if median > MAX_MEDIAN_MATCH_FRACTION * source_size:
+        raise InputError(
+            f"'{target_name}' would copy weights from points of '{source_name}' {median:.3g} away (median), "
+            f"{median / source_size:.3g} times the size of '{source_name}': it is not on the body "
+            f"(match distance {max_distance:.3g}). Move it onto the body or lower the match distance. "
+            f"{ALLOW_POOR_MATCH_HINT}"
+        )
+
+
+def poor_match_cause(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+                     eligible: np.ndarray, max_distance: float, options: TransferOptions) -> str:
+    """Why few of the ``eligible`` vertices copy, as a sentence for the user,
+    the surest cause first: another unit scale fits much better, most of
+    them lie over parts of the body without weights, their normals disagree,
+    or (otherwise) the objects are apart."""
+    factor = _unit_factor(source, target, target_normals, options)
+    if factor is not None:
+        return _unit_cause(factor, source, target)
+    source_name = source.object_names[0]
+    copied = np.count_nonzero(matches.matched & eligible)
+    unweighted = np.count_nonzero(matches.unweighted & eligible)
+    if unweighted > copied:
+        return (f"{unweighted} of its vertices lie over parts of '{source_name}' without usable weights: "
+                "weight those parts of the body first.")
+    turned = np.count_nonzero((matches.distances <= max_distance) & eligible) - copied - unweighted
+    if turned > copied:
+        flipped = "" if options.accept_flipped_normals else ", turn on Flipped Normals"
+        return (f"{turned} of its vertices lie that near but their normals differ from the body's by more than "
+                f"{options.max_normal_angle:g} degrees: recalculate the normals (Shift+N){flipped} or raise the "
+                "normal angle.")
+    return ("Are the objects far apart or at different scales? Apply their transforms (Ctrl+A) "
+            "or raise the match distance.")
+
+
+def _unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, options: TransferOptions) -> UnitFactor | None:
+    return likely_unit_factor(source, target, target_normals, options.distance_fraction,
+                              options.max_normal_angle, options.accept_flipped_normals)
+
+
+def _unit_cause(factor: UnitFactor, source: Mesh, target: Mesh) -> str:
+    return (f"{factor.describe(target.object_names[0], source.object_names[0])} "
+            "Fix the units or the object scale, then apply it (Ctrl+A).")
+
+
+def _no_match_message(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+                      max_distance: float, options: TransferOptions) -> str:
+    everything = np.ones(len(matches.matched), dtype=bool)
+    cause = poor_match_cause(source, target, target_normals, matches, everything, max_distance, options)
+    return (f"No vertex of '{target.object_names[0]}' lies within {max_distance:.4g} of "
+            f"'{source.object_names[0]}' with agreeing normals on weighted parts. {cause} {ALLOW_POOR_MATCH_HINT}")
+
+
+def _require_normalised_rows(weights: np.ndarray) -> None:
+    """Raise AssertionError unless every row is finite, non-negative and sums
+    to one: a transfer never writes an empty or unnormalised row (a bug if it
+    would, so not an :class:`InputError`)."""
+    sums = weights.sum(axis=1)
+    bad = ~(np.all(np.isfinite(weights) & (weights >= 0.0), axis=1) & (np.abs(sums - 1.0) <= ROW_SUM_TOLERANCE))
+    if bad.any():
+        raise AssertionError(f"Transfer produced {np.count_nonzero(bad)} empty or unnormalised rows "
+                             f"(first: vertex {int(np.flatnonzero(bad)[0])}).")
+
+
+def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: TransferOptions) -> np.ndarray:
+    """Raise :class:`InputError` for unusable input; returns the source's
+    usable rows (:func:`check_source_weights`)."""
     if not len(source.triangles):
         raise InputError(f"The source '{source.object_names[0]}' has no faces; weights are transferred from a surface.")
     if not len(target.triangles):
         raise InputError(f"The target '{target.object_names[0]}' has no faces; it needs a surface to inpaint over.")
-    if source_weights.vertex_count != source.vertex_count:
-        raise InputError("The source weights do not have one row per source vertex.")
-    check_weights(source_weights.matrix, "source weights")
-    if not source_weights.bone_names or not np.any(source_weights.matrix > 0):
-        raise InputError(f"The source '{source.object_names[0]}' carries no bone weights to transfer.")
+    usable = check_source_weights(source, source_weights)
     if not (options.max_normal_angle > 0 and options.max_normal_angle <= 180):
         raise InputError("The normal angle must lie in (0, 180] degrees.")
     if options.max_distance is None and not options.distance_fraction > 0:
@@ -216,15 +404,18 @@ def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: 
         raise InputError("The match distance must be positive.")
     if not 0.0 <= options.smoothing_strength <= 1.0:
         raise InputError("Smoothing strength must lie in [0, 1].")
-    if not (np.all(np.isfinite(source.vertices)) and np.all(np.isfinite(target.vertices))):
-        raise InputError("A mesh has NaN or infinite vertex positions.")
+    for mesh in (source, target):
+        require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     source_diagonal, target_diagonal = source.bounding_box_diagonal, target.bounding_box_diagonal
     if target_diagonal <= 0:
         raise InputError(f"The target '{target.object_names[0]}' has zero size.")
     if target_diagonal > MAX_SCALE_RATIO * source_diagonal:
+        factor = _unit_factor(source, target, vertex_normals(target.vertices, target.triangles), options)
         raise InputError(
-            f"The target is {target_diagonal / max(source_diagonal, 1e-300):.0f} times larger than the source: "
-            "the objects look like they are at different scales. Apply their scale (Ctrl+A) or fix the units."
+            f"The target '{target.object_names[0]}' is {target_diagonal / max(source_diagonal, 1e-300):.3g} times "
+            f"larger than the source '{source.object_names[0]}': they look like they are at different scales. "
+            + (_unit_cause(factor, source, target) if factor is not None else
+               "Apply their scale (Ctrl+A) or fix the units.")
         )
     margin = options.distance_fraction * target_diagonal if options.max_distance is None else options.max_distance
     source_min, source_max = source.vertices.min(0) - margin, source.vertices.max(0) + margin
@@ -234,6 +425,7 @@ def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: 
             f"'{target.object_names[0]}' does not overlap the source '{source.object_names[0]}': "
             "move the garment onto the body (or apply the object transforms) before transferring."
         )
+    return usable
 
 
 def _optional_mask(mask: np.ndarray | None, n: int, what: str) -> np.ndarray:

@@ -1,0 +1,175 @@
+"""What an object is to a weighting run, besides a mesh to weight.
+
+- **Helpers the user never made to be seen**: bone custom shapes (the glTF
+  importer's ``Icosphere``), objects hidden from render, objects in no
+  rendered collection of the scene. A run never picks them by itself
+  (:func:`without_helpers`); named explicitly, they are weighted like any mesh.
+- **Props parented to a bone** (KayKit helmets, swords, shields, capes):
+  already rigged, rigidly. Picked by a run itself they are left as they are;
+  named or selected, they are bound wholly to that bone and the bone parent
+  is replaced by the armature (:class:`RigidBinding`), keeping their rest
+  position, so posing moves them exactly as before. A mesh is never both
+  deformed by an Armature modifier and carried by a bone.
+- **Linked duplicates** (Alt+D: two gloves sharing one mesh): weights live
+  in the mesh, so each object written gets a mesh of its own first
+  (:func:`give_own_mesh`), or the second glove would overwrite the first's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import bpy
+from mathutils import Matrix
+
+from ..core.errors import InputError
+from ..core.messages import listed_names
+from .convert import armatures_at_rest, deform_bone_names
+
+
+@dataclass(frozen=True)
+class RigidBinding:
+    """A prop parented to a bone, to be bound wholly to that bone.
+
+    Attributes
+    ----------
+    obj : bpy.types.Object, the mesh
+    armature : bpy.types.Object, the armature its bone belongs to
+    bone : str, the bone's name (a deform bone)
+    rest_world : mathutils.Matrix, the object's world matrix with the armature
+        in its rest position: where the Armature modifier must start from
+    """
+
+    obj: object
+    armature: object
+    bone: str
+    rest_world: Matrix
+
+    @property
+    def note(self) -> str:
+        """What the report says about the object (after its name)."""
+        return f"bound wholly to bone '{self.bone}' (it was parented to that bone)"
+
+
+def bone_parent(obj) -> str | None:
+    """Name of the bone ``obj`` is parented to, or None when it has no bone parent."""
+    if obj.parent is not None and obj.parent.type == "ARMATURE" and obj.parent_type == "BONE" and obj.parent_bone:
+        return obj.parent_bone
+    return None
+
+
+def left_rigid_note(obj) -> str:
+    """What the report says (after the object's name) about a bone-parented
+    prop a run leaves as it is."""
+    return f"left rigid, parented to bone '{bone_parent(obj)}'"
+
+
+def rigid_binding(obj, armature) -> RigidBinding | None:
+    """How to bind the bone-parented ``obj`` to ``armature``, or None when
+    ``obj`` has no bone parent or its bone does not deform (it then stays
+    rigid on its bone: binding it to a bone the Armature modifier ignores
+    would leave it behind).
+
+    Raises
+    ------
+    InputError when the bone belongs to another armature.
+    """
+    bone = bone_parent(obj)
+    if bone is None:
+        return None
+    if obj.parent != armature:
+        raise InputError(
+            f"'{obj.name}' is parented to bone '{bone}' of '{obj.parent.name}', not of '{armature.name}': "
+            f"clear its parent (Alt+P > Clear and Keep Transformation) to weight it to '{armature.name}'."
+        )
+    if bone not in deform_bone_names(armature):
+        return None
+    with armatures_at_rest([obj]):
+        rest_world = obj.matrix_world.copy()
+    return RigidBinding(obj, armature, bone, rest_world)
+
+
+def split_bone_parented(objects: list, armature, named: bool) -> tuple[list, list, list]:
+    """Split ``objects`` into (plain meshes, rigid bindings, props left rigid).
+
+    Props on a bone are bound wholly to it (:func:`rigid_binding`) when
+    ``named`` (the user named or selected them); props a run picked itself,
+    and props on a bone that does not deform, are left as they are.
+    """
+    plain, rigid, left = [], [], []
+    for obj in objects:
+        if bone_parent(obj) is None:
+            plain.append(obj)
+            continue
+        binding = rigid_binding(obj, armature) if named else None
+        if binding is None:
+            left.append(obj)
+        else:
+            rigid.append(binding)
+    return plain, rigid, left
+
+
+def custom_shape_objects() -> set:
+    """Objects any armature of the file displays its bones with."""
+    return {
+        pose_bone.custom_shape
+        for obj in bpy.data.objects if obj.type == "ARMATURE" and obj.pose is not None
+        for pose_bone in obj.pose.bones if pose_bone.custom_shape is not None
+    }
+
+
+def _rendered_collections(scene) -> set:
+    """The scene's collections whose objects render: its master collection and
+    the children reached through collections not hidden from render."""
+    rendered, pending = {scene.collection}, [scene.collection]
+    while pending:
+        for child in pending.pop().children:
+            if not child.hide_render and child not in rendered:
+                rendered.add(child)
+                pending.append(child)
+    return rendered
+
+
+def without_helpers(objects: list, context=None) -> list:
+    """``objects`` without the helpers of ``context``'s scene (default: the
+    current context): bone shapes, objects hidden from render and objects
+    outside the view layer or in no rendered collection."""
+    context = context or bpy.context
+    shapes = custom_shape_objects()
+    rendered = _rendered_collections(context.scene)
+    in_view_layer = set(context.view_layer.objects)
+    return [
+        obj for obj in objects
+        if obj not in shapes and not obj.hide_render and obj in in_view_layer and set(obj.users_collection) & rendered
+    ]
+
+
+def mesh_sharers(obj) -> list:
+    """Other objects using ``obj``'s mesh datablock (linked duplicates)."""
+    return [other for other in bpy.data.objects if other != obj and other.data is not None and other.data == obj.data]
+
+
+def shared_mesh_notes(objects: list) -> dict:
+    """What the report says (after the object's name) about the linked
+    duplicates among ``objects``, as {object: note}.
+
+    ``objects`` are written in this order, and each gets a copy of its mesh
+    (:func:`give_own_mesh`) when another object still uses that mesh at its
+    turn: the last of a group written together keeps the original, by then
+    its own, and gets no note."""
+    notes, written = {}, set()
+    for obj in objects:
+        sharers = [other for other in mesh_sharers(obj) if other not in written]
+        written.add(obj)
+        if sharers:
+            names = listed_names([other.name for other in sharers], quoted=True)
+            notes[obj] = (f"shared its mesh '{obj.data.name}' with {names}: it now has its own copy, "
+                          "so each keeps its own weights")
+    return notes
+
+
+def give_own_mesh(obj) -> None:
+    """Give ``obj`` a copy of its mesh when another object uses the same one;
+    :class:`~.snapshot.ObjectSnapshot` puts the shared mesh back on failure."""
+    if mesh_sharers(obj):
+        obj.data = obj.data.copy()
