@@ -323,3 +323,16 @@ def test_point_like_gltf_bones_get_tails_on_the_child_heads(clean_scene, tmp_pat
     z = character.mesh.vertices[:, 2]
     assert share[z < 0.2 * step, 0].min() > 0.9
     assert share[z > 2.2 * step, 2].min() > 0.9
+
+
+def test_point_like_bone_above_mirrored_children_continues_its_parent_line():
+    # spine (real) -> pelvis (point-like, deform) -> thigh.L / thigh.R (mirror twins).
+    joints = [[0, 0, 2], [0, 0, 1], [0.2, 0, 1], [-0.2, 0, 1]]
+    tails = [[0, 0, 1], [0, 0, 1.0000001], [0.2, 0, 0], [-0.2, 0, 0]]
+    skeleton = Skeleton(joints, [-1, 0, 1, 1], ("spine", "pelvis", "thigh.L", "thigh.R"), tails)
+    fixed, decision = with_reliable_tails(skeleton, 3.0)
+    # No child continues the pelvis, so it keeps the spine's downward line for the spine's length.
+    np.testing.assert_allclose(fixed.tails[1], [0, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(fixed.tails[[0, 2, 3]], skeleton.tails[[0, 2, 3]])
+    assert decision.derived == ("pelvis",)
+    assert decision.note.endswith("continue their parent's line between mirrored children")

@@ -403,7 +403,13 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
         return replace(skeleton, tails=tails), TailDecision(tuple(skeleton.names), True, reason)
     point_like = skeleton.bone_lengths < POINT_LIKE_FRACTION * size
     child, _ = continued_children(skeleton.joints, skeleton.parents)
-    stuck = np.flatnonzero(point_like & (child < 0) & skeleton.deform)
+    # A joint whose children are all mirror twins (a pelvis over the two
+    # thighs) continues no child but is not a leaf: it keeps its parent's
+    # line, as derived_tails gives it. Only a point-like deform leaf has no
+    # direction at all.
+    has_children = np.array([len(kids) > 0 for kids in _children_apart(skeleton.joints, skeleton.parents)], dtype=bool)
+    between_twins = point_like & (child < 0) & has_children
+    stuck = np.flatnonzero(point_like & (child < 0) & ~has_children & skeleton.deform)
     if len(stuck):
         names = [skeleton.names[j] for j in stuck]
         if len(names) == 1:
@@ -411,13 +417,21 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
         else:
             message = f"Deform bones {listed_names(names, quoted=True)} have zero length and no child to point at: give them a length"
         raise InputError(f"{message} in Edit Mode.")
-    fixed = np.flatnonzero(point_like & (child >= 0))
+    fixed = np.flatnonzero(point_like & ((child >= 0) | between_twins))
     if not len(fixed):
         return skeleton, TailDecision((), False, assessment.reason)
     tails = skeleton.tails.copy()
-    tails[fixed] = skeleton.joints[child[fixed]]
+    continued = fixed[child[fixed] >= 0]
+    tails[continued] = skeleton.joints[child[continued]]
+    twin_parents = fixed[child[fixed] < 0]
+    if len(twin_parents):
+        tails[twin_parents] = derived_tails(skeleton.joints, skeleton.parents)[twin_parents]
+        lone = twin_parents[np.isnan(tails[twin_parents]).any(axis=1)]
+        tails[lone] = skeleton.joints[lone] + (0.0, 0.0, LONE_ROOT_LENGTH_FRACTION * size)
     names = tuple(skeleton.names[j] for j in fixed)
     one = len(names) == 1
+    ending = "now end at the child they continue" if not len(twin_parents) else (
+        "now end at the child they continue, or continue their parent's line between mirrored children")
     reason = (f"{listed_names(names, quoted=True)} {'is' if one else 'are'} shorter than {100 * POINT_LIKE_FRACTION:.2g} % of the "
-              f"character and now end{'s' * one} at {'its' if one else 'their'} child")
+              f"character and {ending}")
     return replace(skeleton, tails=tails), TailDecision(names, False, reason)
