@@ -6,8 +6,9 @@ Usage (from the repo root)::
 
 Loads ``../shared/data/makehuman/body.glb`` (the skinned source) and one
 garment, runs both methods ``--repeat`` times in this process and prints a
-markdown table of per-stage medians, the ratio to closest-point copying and
-the peak resident memory added by one transfer. The numbers in
+markdown table of per-stage medians (the surface smoothing is the ``smooth``
+stage; the transfer without it is timed too), the ratio to closest-point
+copying and the peak resident memory added by one transfer. The numbers in
 ``docs/benchmarks.md`` come from this script.
 """
 
@@ -24,7 +25,7 @@ sys.path.insert(0, REPO)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.transfer import transfer_weights  # noqa: E402
+from autorig_addon.core.transfer import TransferOptions, transfer_weights  # noqa: E402
 from autorig_addon.core.transfer.matching import closest_point_weights  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
@@ -54,7 +55,8 @@ def main(argv=None) -> int:
     source, source_weights, target = load_inputs(args.garment)
     transfer_weights(source, source_weights, target)  # warm-up: imports, caches
     stage_times: dict[str, list[float]] = {}
-    totals, baseline = [], []
+    totals, baseline, unsmoothed = [], [], []
+    without_smoothing = TransferOptions(smoothing_length=0.0)
     for _ in range(args.repeat):
         start = time.perf_counter()
         closest_point_weights(source, source_weights, target)
@@ -62,6 +64,9 @@ def main(argv=None) -> int:
         start = time.perf_counter()
         result = transfer_weights(source, source_weights, target)
         totals.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        transfer_weights(source, source_weights, target, without_smoothing)
+        unsmoothed.append(time.perf_counter() - start)
         for stage, seconds in result.timings.items():
             stage_times.setdefault(stage, []).append(seconds)
     memory = peak_rss_added(lambda: transfer_weights(source, source_weights, target))
@@ -75,6 +80,7 @@ def main(argv=None) -> int:
     for stage, values in stage_times.items():
         print(f"| {stage} | {statistics.median(values):.3f} |")
     print(f"| **total robust transfer** | **{median_total:.3f}** |")
+    print(f"| robust transfer without surface smoothing | {statistics.median(unsmoothed):.3f} |")
     print(f"| closest-point copy (baseline) | {median_baseline:.3f} |")
     print(f"\nRatio robust / closest-point copy: {median_total / median_baseline:.2f}x "
           f"(min {min(totals):.3f} s, max {max(totals):.3f} s)")

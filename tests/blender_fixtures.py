@@ -99,6 +99,12 @@ def make_armature(name: str = "Armature", deform_upper: bool = True) -> bpy.type
     return obj
 
 
+#: How closely a transferred sleeve follows the body's blend: the transfer's
+#: default surface smoothing (``core.transfer.options.DEFAULT_SMOOTHING_LENGTH``)
+#: rounds the blend's kinks at ``BLEND_START`` and ``BLEND_END`` by up to 0.3 %.
+COPY_TOLERANCE = 5e-3
+
+
 def expected_body_weights(z: np.ndarray) -> np.ndarray:
     """(n, 2) weights (Lower, Upper) of the body at heights ``z``."""
     upper = np.clip((np.asarray(z) - BLEND_START) / (BLEND_END - BLEND_START), 0.0, 1.0)

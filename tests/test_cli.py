@@ -25,6 +25,7 @@ from autorig_addon.core.transfer.combine import MIX, REPLACE_ALL
 from autorig_addon.core.transfer.options import TransferOptions
 from autorig_addon.core.weights import MAX_INFLUENCES
 from blender_fixtures import (
+    COPY_TOLERANCE,
     LOWER_BONE,
     UPPER_BONE,
     build_rig_scene,
@@ -73,7 +74,7 @@ def assert_tube_weights_follow_the_body(sleeve, positions):
     weights = convert.read_weights(sleeve, BONES).matrix
     tube = np.hypot(positions[:, 0], positions[:, 1]) < 0.4
     assert tube.sum() > 500 and (~tube).sum() >= 8
-    np.testing.assert_allclose(weights[tube], expected_body_weights(positions[tube, 2]), atol=1e-3)
+    np.testing.assert_allclose(weights[tube], expected_body_weights(positions[tube, 2]), atol=COPY_TOLERANCE)
     np.testing.assert_allclose(weights[~tube], [[1.0, 0.0]] * int((~tube).sum()), atol=1e-3)
 
 
@@ -161,6 +162,8 @@ def test_option_bounds_are_the_panels(clean_scene):
         ("transfer", "--smoothing-iterations", "smoothing_iterations", 0, MAX_SMOOTHING_ITERATIONS),
         ("transfer", "--max-influences", "max_influences", 0, MAX_INFLUENCES),
         ("transfer", "--smoothing-strength", "smoothing_strength", 0.0, 1.0),
+        ("transfer", "--smoothing-length", "smoothing_length",
+         transfer_options.MIN_SMOOTHING_LENGTH, transfer_options.MAX_SMOOTHING_LENGTH),
         ("skin", "--resolution", "skin_resolution", MIN_RESOLUTION, MAX_RESOLUTION),
         ("skin", "--falloff", "skin_falloff", skinning.MIN_FALLOFF, skinning.MAX_FALLOFF),
         ("skin", "--max-influences", "skin_max_influences", 0, MAX_INFLUENCES),
@@ -188,6 +191,7 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     assert (transfer.accept_flipped_normals, transfer.smoothing_iterations, transfer.max_influences, transfer.mask_group) == (
         settings.accept_flipped_normals, settings.smoothing_iterations, settings.max_influences, settings.mask_group)
     assert transfer.smoothing_strength == pytest.approx(settings.smoothing_strength)
+    assert transfer.smoothing_length == pytest.approx(settings.smoothing_length)
     assert transfer.allow_poor_match == settings.allow_poor_match == transfer_options.DEFAULT_ALLOW_POOR_MATCH
     assert cli_transfer.transfer_settings(parse(["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--allow-poor-match"])
                                           ).options.allow_poor_match is True

@@ -246,11 +246,16 @@ def test_robust_transfer_self_check(clean_scene, tmp_path, capsys):
     vertices, triangles, reference = body_arrays()
     target = self_transfer_target(Mesh(vertices, triangles), BODY_SIZE)
     expected = evaluate_transfer(target.vertices, edges(target.triangles), reference, SKELETON, reference)
-    assert (entry["kind"], entry["deform_mean"], entry["deform_max"]) == ("self", 0.0, 0.0)
-    assert entry["stretch_p99"] == pytest.approx(expected["stretch_p99"], rel=1e-5)
-    assert entry["stretch_max"] == pytest.approx(expected["stretch_max"], rel=1e-5)
+    # The default surface smoothing damps weight detail finer than 0.5 % of the
+    # body, copied rows included: the weights come back within a hair of the body's.
+    assert entry["kind"] == "self"
+    assert entry["deform_mean"] == pytest.approx(0.0, abs=2e-5)
+    assert entry["deform_max"] == pytest.approx(0.0, abs=5e-4)
+    assert entry["stretch_p99"] == pytest.approx(expected["stretch_p99"], rel=1e-2)
+    assert entry["stretch_max"] == pytest.approx(expected["stretch_max"], rel=1e-2)
     assert "| character | stretch_p99 | stretch_max | deform_mean | deform_max | seconds |" in stdout
-    assert f"| body | {entry['stretch_p99']:.4g} | {entry['stretch_max']:.4g} | 0 | 0 |" in stdout
+    assert (f"| body | {entry['stretch_p99']:.4g} | {entry['stretch_max']:.4g} | {entry['deform_mean']:.4g} | "
+            f"{entry['deform_max']:.4g} |") in stdout
 
 
 def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
@@ -331,3 +336,30 @@ def test_baseline_report_is_shown_beside(clean_scene, tmp_path, capsys):
     assert capsys.readouterr().err == (
         f"error: '{tmp_path / 'wrong.json'}' is not a report of an 'skin' evaluation (write one with --out).\n"
     )
+
+
+def test_out_naming_a_folder_is_a_usage_error_before_anything_runs(tmp_path, capsys, monkeypatch):
+    (tmp_path / "reports").mkdir()
+    monkeypatch.setattr(evaluate, "evaluate", lambda *args: pytest.fail("the evaluation ran"))
+    capsys.readouterr()
+    # The data need not exist: --out is checked first.
+    assert main(["eval", "skin", str(tmp_path / "missing"), "--method", "reference",
+                 "--out", str(tmp_path / "reports")]) == 2
+    assert capsys.readouterr().err == f"error: --out {str(tmp_path / 'reports')!r} is a folder; name a file in it.\n"
+
+
+def test_a_predicted_rig_with_a_joint_on_its_parent_is_scored(clean_scene, tmp_path, capsys):
+    """No armature is built from a predicted rig: a joint at its parent's
+    position (a zero-length bone) is scored, not refused."""
+    save_body(tmp_path / "body.blend")
+    predicted = tmp_path / "predicted"
+    predicted.mkdir()
+    (predicted / "body.txt").write_text(
+        f"joints {LOWER_BONE} 0 0 0\njoints {UPPER_BONE} 0 0 1\njoints Extra 0 0 1\n"
+        f"root {LOWER_BONE}\nhier {LOWER_BONE} {UPPER_BONE}\nhier {UPPER_BONE} Extra\n")
+    code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{predicted}"], tmp_path, capsys)
+    assert code == 0
+    (entry,) = report["characters"]
+    assert "error" not in entry
+    # The two reference joints are matched exactly; the extra one lies on one of them.
+    assert entry["cd_j2j"] == 0.0

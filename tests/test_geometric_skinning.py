@@ -6,10 +6,11 @@ import re
 
 import numpy as np
 import pytest
-from geometry_fixtures import box_mesh, cylinder, grid
+from geometry_fixtures import box_mesh, cylinder, grid, subdivided
 
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.geometry.segments import point_segment_distances
+from autorig_addon.core.skinning import geometric
 from autorig_addon.core.skinning.geometric import geometric_weights, sees_nearest_bone
 from autorig_addon.core.skinning.heat_diffusion import heat_diffusion_weights
 from autorig_addon.core.types import Mesh, Skeleton
@@ -235,3 +236,86 @@ def test_bad_input_is_rejected_with_a_clear_message():
         arguments = {"mesh": mesh, "skeleton": skeleton, **options}
         with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
             geometric_weights(arguments.pop("mesh"), arguments.pop("skeleton"), **arguments)
+
+
+# --------------------------------------------------------------------------- big meshes: the proxy
+
+
+@pytest.fixture(scope="module")
+def fine_cylinder_with_button():
+    """The two-bone cylinder subdivided to 15,746 vertices, and a 2 cm box
+    (a button, its own part) 1 mm off its side just above the joint, where
+    the body blends the two bones."""
+    body = subdivided(two_bone_cylinder()[0], 2)
+    button = box_mesh([0.201, -0.01, 1.04], [0.221, 0.01, 1.06], 0.01)
+    return Mesh.concatenate([body, button]), body.vertex_count
+
+
+def solved_on_proxy(monkeypatch, proxy_vertices):
+    """Make every mesh above 1,000 vertices go through a proxy of about ``proxy_vertices``."""
+    monkeypatch.setattr(geometric, "PROXY_VERTEX_THRESHOLD", 1000)
+    monkeypatch.setattr(geometric, "PROXY_VERTICES", proxy_vertices)
+
+
+def test_meshes_below_the_threshold_are_solved_vertex_by_vertex(monkeypatch):
+    def refuse(*args):
+        raise AssertionError("no proxy below the threshold")
+
+    monkeypatch.setattr(geometric, "simplified_proxy", refuse)
+    mesh, skeleton = two_bone_cylinder()
+    assert mesh.vertex_count <= geometric.PROXY_VERTEX_THRESHOLD
+    assert_valid(geometric_weights(mesh, skeleton), 2)
+
+
+def test_weights_through_the_proxy_approach_the_full_solution_as_it_is_refined(monkeypatch, fine_cylinder_with_button):
+    mesh, _ = fine_cylinder_with_button
+    _, skeleton = two_bone_cylinder()
+    full = geometric_weights(mesh, skeleton).matrix
+    errors = []
+    for proxy_vertices in (750, 1500, 3000):
+        solved_on_proxy(monkeypatch, proxy_vertices)
+        weights = geometric_weights(mesh, skeleton)
+        assert_valid(weights, 2)
+        errors.append(np.abs(weights.matrix - full).max())
+    # The error follows the cell size (the square root of the vertex
+    # count): each doubling of the proxy shrinks it, here to under 0.03.
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 0.03
+
+
+def test_a_button_touching_a_big_body_keeps_its_own_bone(monkeypatch, fine_cylinder_with_button):
+    mesh, body_count = fine_cylinder_with_button
+    _, skeleton = two_bone_cylinder()
+    solved_on_proxy(monkeypatch, 1500)
+    weights = geometric_weights(mesh, skeleton).matrix
+    # The button lies wholly above the joint: every one of its vertices is
+    # nearest the upper bone, so heat in the button alone gives exactly that
+    # bone, while the body it touches blends both bones there.
+    np.testing.assert_array_equal(weights[body_count:], [[0.0, 1.0]] * (mesh.vertex_count - body_count))
+    z = mesh.vertices[:body_count, 2]
+    beside = np.abs(z - 1.05) < 0.02
+    assert np.all((weights[:body_count][beside, 1] > 0.5) & (weights[:body_count][beside, 1] < 0.9))
+
+
+def test_given_distances_are_averaged_onto_the_proxy(monkeypatch, fine_cylinder_with_button):
+    mesh, _ = fine_cylinder_with_button
+    _, skeleton = two_bone_cylinder()
+    distances = straight_distances(mesh, skeleton)
+    full = geometric_weights(mesh, skeleton, distances=distances).matrix
+    solved_on_proxy(monkeypatch, 3000)
+    reports = []
+    weights = geometric_weights(mesh, skeleton, distances=distances, progress=lambda f, m: reports.append(m))
+    assert_valid(weights, 2)
+    assert np.abs(weights.matrix - full).max() < 0.05
+    assert reports == ["Simplifying the mesh", "Diffusing bone heat", "Carrying the weights to every vertex", "Weights done"]
+
+
+def test_a_far_prop_on_a_big_mesh_binds_wholly_to_its_nearest_bone(monkeypatch, fine_cylinder_with_button):
+    body, _ = fine_cylinder_with_button
+    _, skeleton = two_bone_cylinder()
+    prop = box_mesh([-0.1, -0.1, 4.0], [0.1, 0.1, 4.2], 0.05)
+    mesh = Mesh.concatenate([body, prop])
+    solved_on_proxy(monkeypatch, 1500)
+    weights = geometric_weights(mesh, skeleton, max_influences=1)
+    assert_valid(weights, 1)
+    np.testing.assert_array_equal(weights.matrix[body.vertex_count:], [[0.0, 1.0]] * prop.vertex_count)

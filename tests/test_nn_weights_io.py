@@ -73,3 +73,21 @@ def test_a_newer_format_is_refused(tmp_path):
     with pytest.raises(InputError, match=f"holds weights in format {WEIGHTS_FORMAT_VERSION + 1}, but this add-on "
                                          f"reads format {WEIGHTS_FORMAT_VERSION}"):
         load_weights(str(path))
+
+
+def test_a_saved_file_gets_the_usual_permissions(tmp_path):
+    previous = os.umask(0o022)
+    try:
+        save_weights(str(tmp_path / "net.npz"), {"a": np.zeros(2)})
+    finally:
+        os.umask(previous)
+    assert (tmp_path / "net.npz").stat().st_mode & 0o777 == 0o644
+    assert [path.name for path in tmp_path.iterdir()] == ["net.npz"]
+
+
+def test_corrupted_metadata_is_an_input_error(tmp_path):
+    path = tmp_path / "broken.npz"
+    np.savez(path, **{FORMAT_VERSION_KEY: np.asarray(WEIGHTS_FORMAT_VERSION), METADATA_KEY: np.asarray("{not json"),
+                      "a": np.zeros(2)})
+    with pytest.raises(InputError, match=r"broken\.npz is not a network weights file \(unreadable version or metadata: "):
+        load_weights(str(path))

@@ -16,6 +16,7 @@ from autorig_addon.blender.operators.transfer import TransferSettings, run_trans
 from autorig_addon.core.errors import InputError
 from blender_fixtures import (
     BODY_RADIUS,
+    COPY_TOLERANCE,
     LOWER_BONE,
     UPPER_BONE,
     box_geometry,
@@ -188,7 +189,7 @@ def test_default_targets_skip_helpers_and_leave_props_on_bones_rigid(clean_scene
         "Sleeve": "544 copied, 0 inpainted (0%)", "Helmet": "left rigid, parented to bone 'Upper'"}
     assert scene_state(untouched) == before
     np.testing.assert_allclose(group_weights(rig.sleeve, [LOWER_BONE, UPPER_BONE]),
-                               expected_body_weights(np.array([v.co.z for v in rig.sleeve.data.vertices])), atol=1e-3)
+                               expected_body_weights(np.array([v.co.z for v in rig.sleeve.data.vertices])), atol=COPY_TOLERANCE)
 
 
 def test_default_targets_with_only_props_and_helpers_is_refused_unchanged(clean_scene):
@@ -314,3 +315,16 @@ def test_a_failed_write_shares_the_mesh_again_and_leaves_no_copy(clean_scene, mo
     assert lower.data == upper.data
     assert sorted(mesh.name for mesh in bpy.data.meshes) == meshes_before
     assert scene_state([rig.body, lower, upper]) == before
+
+
+def test_skinning_default_meshes_that_are_all_helpers_is_refused_naming_them(clean_scene):
+    from autorig_addon.blender.operators.skin import SkinSettings, plan_skin
+
+    rig = build_rig_scene(with_button=False)
+    shape = bone_shape(rig.armature)
+    before = scene_state([rig.armature, shape])
+    with pytest.raises(InputError, match=re.escape(
+            f"Nothing to skin: the meshes found ('{shape.name}') are helpers (bone shapes, hidden from render). "
+            "Name the meshes to skin them: --mesh on the command line, meshes= from Python.")):
+        plan_skin(rig.armature, [shape], SkinSettings(), bpy.context.evaluated_depsgraph_get(), named=False)
+    assert scene_state([rig.armature, shape]) == before

@@ -266,3 +266,6 @@ def test_a_joint_at_its_parents_position_is_refused(text, message):
             f"{message}, so the bone between them has no length or direction (1 such joint(s)). Move one of them, "
             "or remove the duplicate and give its children to the other.") + "$"):
         read_rignet_rig(text)
+    # Read for its joints alone (a predicted rig scored by eval), the file is accepted as it is.
+    skeleton, _ = read_rignet_rig(text, for_armature=False)
+    assert skeleton.bone_count == text.count("joints ")

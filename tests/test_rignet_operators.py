@@ -208,3 +208,28 @@ def test_export_refuses_an_armature_without_deform_bones(clean_scene, tmp_path):
     with pytest.raises(InputError, match="^'Controls' has no deform bones to export.$"):
         rignet.export_rignet_rig(str(path), armature)
     assert not path.exists()
+
+
+def test_import_onto_a_linked_duplicate_gives_it_its_own_mesh(clean_scene, tmp_path, capfd):
+    import bpy
+
+    scene = build_rig_scene(with_button=False)
+    path = str(tmp_path / "rig.txt")
+    select_only([scene.body], active=scene.body)
+    assert bpy.ops.autorig.export_rignet(filepath=path) == {"FINISHED"}
+    mesh = scene.body.data.copy()  # shared by two objects below
+    first = bpy.data.objects.new("First", mesh)
+    twin = bpy.data.objects.new("Twin", mesh)
+    for obj in (first, twin):
+        bpy.context.scene.collection.objects.link(obj)
+        obj.vertex_groups.clear()
+    mesh_weights_before = [[(e.group, e.weight) for e in v.groups] for v in mesh.vertices]
+    select_only([first], active=first)
+    capfd.readouterr()
+    assert bpy.ops.autorig.import_rignet(filepath=path) == {"FINISHED"}
+    assert first.data is not mesh and twin.data is mesh
+    assert [[(e.group, e.weight) for e in v.groups] for v in mesh.vertices] == mesh_weights_before
+    _, weights = read_rignet_rig(path, vertex_count=len(mesh.vertices))
+    np.testing.assert_allclose(group_weights(first, (LOWER_BONE, UPPER_BONE)), weights.matrix, atol=1e-6)
+    assert (f"Imported 'rig' with 2 bones, 'First' bound; it shared its mesh '{mesh.name}' with 'Twin': it now has "
+            "its own copy, so each keeps its own weights.") in capfd.readouterr().out

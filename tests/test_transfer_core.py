@@ -11,8 +11,13 @@ import re
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
 
 from autorig_addon.core.errors import InputError
+from autorig_addon.core.geometry import sparse_solve
+from autorig_addon.core.geometry.laplacian import cotangent_laplacian, voronoi_mass
+from autorig_addon.core.geometry.smoothing import smooth_over_surface
 from autorig_addon.core.transfer import TransferOptions, VertexStatus, transfer_weights
 from autorig_addon.core.transfer.inpainting import inpaint_weights, inpainting_operator
 from autorig_addon.core.transfer.matching import closest_point_weights, match_closest_points
@@ -27,6 +32,11 @@ def body():
     return mesh, two_bone_weights(mesh)
 
 
+#: The copy and inpainting stages alone, whose answers are exact; the surface
+#: smoothing that follows them by default has its own tests below.
+UNSMOOTHED = TransferOptions(smoothing_length=0.0)
+
+
 def sleeve(radius=0.11, z0=0.05, height=0.9, flip=False, rings=31):
     return cylinder(radius=radius, height=height, z0=z0, segments=40, rings=rings, capped=False, flip=flip)
 
@@ -38,7 +48,7 @@ def expected_upper(z, blend=0.2):
 def test_close_sleeve_copies_the_body_weights(body):
     source, weights = body
     target = sleeve()
-    result = transfer_weights(source, weights, target)
+    result = transfer_weights(source, weights, target, UNSMOOTHED)
     assert np.all(result.status == VertexStatus.COPIED)
     upper = expected_upper(target.vertices[:, 2])
     np.testing.assert_allclose(result.weights.matrix, np.column_stack([1 - upper, upper]), atol=1e-12)
@@ -51,7 +61,7 @@ def test_close_sleeve_copies_the_body_weights(body):
 def test_inner_layer_with_flipped_normals_needs_the_second_pass(body):
     source, weights = body
     target = sleeve(radius=0.095, flip=True)
-    result = transfer_weights(source, weights, target)
+    result = transfer_weights(source, weights, target, UNSMOOTHED)
     assert np.all(result.status == VertexStatus.COPIED_FLIPPED)
     np.testing.assert_allclose(result.weights.matrix[:, 1], expected_upper(target.vertices[:, 2]), atol=1e-12)
     message = (f"No vertex of 'mesh' lies within {result.max_distance:.4g} of 'mesh' with agreeing normals on "
@@ -68,7 +78,7 @@ def test_masked_band_is_inpainted_smoothly_and_symmetrically(body):
     target = sleeve()
     z = target.vertices[:, 2]
     mask = (z > 0.3) & (z < 0.7)
-    result = transfer_weights(source, weights, target, inpaint_mask=mask)
+    result = transfer_weights(source, weights, target, UNSMOOTHED, inpaint_mask=mask)
     assert np.all(result.status[mask] == VertexStatus.MASKED)
     assert np.all(result.status[~mask] == VertexStatus.COPIED)
     upper = result.weights.matrix[:, 1]
@@ -267,7 +277,7 @@ def test_overlap_check_honours_a_larger_match_distance(body):
     target = Mesh(np.column_stack([np.full(len(y), 0.18), y, z]), patch.triangles)
     with pytest.raises(InputError, match="does not overlap"):
         transfer_weights(source, weights, target)
-    result = transfer_weights(source, weights, target, TransferOptions(distance_fraction=0.5))
+    result = transfer_weights(source, weights, target, TransferOptions(distance_fraction=0.5, smoothing_length=0.0))
     # Rows |y| <= 0.05 see the body within 16 degrees of +x and copy it; at
     # |y| = 0.1 the body's normal there is 29 degrees off, and more than 30
     # once interpolated across the 32-gon's facets, so those are inpainted.
@@ -312,7 +322,7 @@ def test_unweighted_or_corrupt_body_rows_never_count_as_a_match(body, value):
     source, _ = body
     painted = body_painted_below(body, 0.71, value)  # body rings from z = 0.725 up carry no usable weight
     target = sleeve()  # rings every 0.03 from z = 0.05
-    result = transfer_weights(source, painted, target)
+    result = transfer_weights(source, painted, target, UNSMOOTHED)
     z = target.vertices[:, 2]
     over_unweighted = z > 0.7  # their closest points lie on (or draw from) the rings above 0.71
     np.testing.assert_array_equal(result.status, np.where(over_unweighted, VertexStatus.INPAINTED, VertexStatus.COPIED))
@@ -422,7 +432,8 @@ def test_protected_vertices_with_nothing_to_keep_are_transferred_not_left_empty(
     top = target.vertices[:, 2] > 0.9
     existing = np.zeros((target.vertex_count, 2))
     existing[top & (target.vertices[:, 0] > 0)] = [0.25, 0.75]  # half the protected ring was painted
-    result = transfer_weights(source, weights, target, protected=top, protected_weights=Weights(existing, ("upper", "lower")))
+    result = transfer_weights(source, weights, target, UNSMOOTHED, protected=top,
+                              protected_weights=Weights(existing, ("upper", "lower")))
     kept = top & (target.vertices[:, 0] > 0)
     np.testing.assert_allclose(result.weights.matrix[kept], [[0.75, 0.25]] * int(kept.sum()), atol=1e-12)
     np.testing.assert_allclose(result.weights.matrix[top & ~kept], [[0.0, 1.0]] * int((top & ~kept).sum()), atol=1e-12)
@@ -441,3 +452,120 @@ def test_matching_falls_back_to_the_nearest_weighted_vertex_where_the_closest_po
     np.testing.assert_array_equal(matches.unweighted, [False, True, False])
     # Vertex 1 draws on the corrupt column: it takes the nearest usable vertex's (x = 0.5) weights.
     np.testing.assert_allclose(matches.weights, [[0.75, 0.25], [0.5, 0.5], [0.5, 0.5]], atol=1e-12)
+
+
+# --------------------------------------------------------------------------- surface smoothing (stage 3)
+
+
+def test_surface_smoothing_of_a_spike_on_a_unit_square_by_hand():
+    # grid(2, 2) is the unit square cut along 0-3: vertices 1 and 2 hold the
+    # right angles, so the sides carry cotangent weight 1/2, the diagonal 0
+    # (cot 90 degrees), and every vertex has Voronoi mass 1/4. With length 1,
+    # (M - L) x = M x0 for a spike x0 = e_0 reads, by symmetry x1 = x2 = b:
+    #   a/4 + 2 (a - b)/2 = 1/4,  b/4 + (b - a)/2 + (b - c)/2 = 0,  c/4 + 2 (c - b)/2 = 0,
+    # so a = 17/45, b = 2/9, c = 8/45: the spike spreads, its mass sum(M x) = 1/4 is kept.
+    square = grid(2, 2)
+    spike = np.array([[1.0], [0.0], [0.0], [0.0]])
+    smoothed = smooth_over_surface(spike, square.vertices, square.triangles, 1.0)
+    np.testing.assert_allclose(smoothed.ravel(), [17 / 45, 2 / 9, 2 / 9, 8 / 45], atol=1e-12)
+    # Lengths are relative to the mesh: three times the square, three times the length.
+    np.testing.assert_allclose(smooth_over_surface(spike, 3 * square.vertices, square.triangles, 3.0), smoothed,
+                               atol=1e-12)
+    # Fixed rows keep their values and hold their neighbours: with 1 and 2 at
+    # zero, vertex 0 solves a/4 + a/2 + a/2 = 1/4 (a = 1/5), and so does 3.
+    fixed = np.array([False, True, True, False])
+    held = smooth_over_surface(np.array([[1.0], [0.0], [0.0], [1.0]]), square.vertices, square.triangles, 1.0, fixed)
+    np.testing.assert_allclose(held.ravel(), [0.2, 0.0, 0.0, 0.2], atol=1e-12)
+    # Length 0 is off; the input is never modified.
+    np.testing.assert_array_equal(smooth_over_surface(spike, square.vertices, square.triangles, 0.0), spike)
+    np.testing.assert_array_equal(spike.ravel(), [1, 0, 0, 0])
+
+
+def test_surface_smoothing_keeps_constants_and_leaves_loose_vertices_alone():
+    square = grid(3, 3)
+    loose = Mesh(np.vstack([square.vertices, [[5.0, 5.0, 5.0]]]), square.triangles)  # vertex 9 is in no triangle
+    rows = np.column_stack([np.full(10, 0.3), np.full(10, 0.7)])
+    rows[9] = [1.0, 0.0]
+    smoothed = smooth_over_surface(rows, loose.vertices, loose.triangles, 0.5)
+    np.testing.assert_allclose(smoothed[:9], [[0.3, 0.7]] * 9, atol=1e-12)
+    np.testing.assert_array_equal(smoothed[9], [1.0, 0.0])
+
+
+def test_default_transfer_smooths_the_copied_ramp_keeping_symmetry_and_mass(body):
+    source, weights = body
+    target = sleeve()
+    plain = transfer_weights(source, weights, target, UNSMOOTHED).weights.matrix
+    length = 0.05  # of the body's 1.04 diagonal: 5 cm, beside the sleeve's 3 cm rings
+    smoothed = transfer_weights(source, weights, target, TransferOptions(smoothing_length=length)).weights.matrix
+    z = target.vertices[:, 2]
+    np.testing.assert_allclose(smoothed.sum(axis=1), 1.0, atol=1e-12)
+    # Heat is conserved: every bone's area-weighted total over the sleeve stays.
+    mass = voronoi_mass(target.vertices, target.triangles)
+    np.testing.assert_allclose(mass @ smoothed, mass @ plain, rtol=1e-9)  # to the solver's tolerance
+    # The sleeve's symmetry (z -> 1 - z swaps the bones) survives: rings stay
+    # rings and the middle ring is half and half.
+    upper = smoothed[:, 1]
+    levels = np.unique(np.round(z, 9))
+    values = np.array([upper[np.isclose(z, h)].mean() for h in levels])
+    assert max(np.ptp(upper[np.isclose(z, h)]) for h in levels) < 1e-9
+    np.testing.assert_allclose(values, 1.0 - values[::-1], atol=1e-9)
+    assert values[levels == 0.5] == pytest.approx(0.5, abs=1e-9)
+    # The ramp's kinks at z = 0.4 and 0.6 are rounded (the ring beside each
+    # moves by 0.1) and the change fades away from them at a known rate. The
+    # sleeve is intrinsically a flat grid of h x s rectangles cut into right
+    # triangles, on which the cotangent Laplacian is the five-point stencil
+    # (weights s/h along z, h/s around, 0 on the diagonals) and every vertex
+    # has mass h s. Where the copy is constant the change d_k of ring k thus
+    # solves d_{k+1} - 2 d_k + d_{k-1} = (h / length)^2 d_k: it shrinks by
+    # the root r < 1 of r + 1/r = 2 + (h / length)^2 per ring away from a kink.
+    change = values - expected_upper(levels)
+    assert change[np.isclose(levels, 0.41)] == pytest.approx(0.103, abs=1e-3)
+    h, reach = 0.03, length * source.bounding_box_diagonal
+    ratio = 1 + (h / reach) ** 2 / 2 - np.sqrt((1 + (h / reach) ** 2 / 2) ** 2 - 1)
+    below = (levels > 0.19) & (levels < 0.36)  # rings 0.20 to 0.35: constant copy, 5 rings above the open end
+    np.testing.assert_allclose(change[below][:-1] / change[below][1:], ratio, rtol=3e-3)
+    assert ratio == pytest.approx(0.566, abs=1e-3)
+    assert np.all(np.diff(values) >= -1e-12)  # still rising
+
+
+def test_surface_smoothing_keeps_protected_rows_and_its_length_is_bounded(body):
+    source, weights = body
+    target = sleeve()
+    top = target.vertices[:, 2] > 0.9
+    existing = np.zeros((target.vertex_count, 2))
+    existing[top] = [0.25, 0.75]
+    result = transfer_weights(source, weights, target, TransferOptions(smoothing_length=0.05), protected=top,
+                              protected_weights=Weights(existing, ("upper", "lower")))
+    np.testing.assert_allclose(result.weights.matrix[top], [[0.75, 0.25]] * int(top.sum()), atol=1e-12)
+    assert set(result.timings) >= {"inpaint", "smooth"}
+    panel_maximum = float(np.float32(0.05))  # what the panel's slider at its end passes: 0.0500000007
+    widest = transfer_weights(source, weights, target, TransferOptions(smoothing_length=panel_maximum))
+    np.testing.assert_allclose(widest.weights.matrix.sum(axis=1), 1.0, atol=1e-12)
+    message = "The smoothing length must lie in [0, 0.05] (a fraction of the source's size)."
+    with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
+        transfer_weights(source, weights, target, TransferOptions(smoothing_length=0.06))
+
+
+@pytest.mark.parametrize("iterations, drop, falls_back", [(sparse_solve.MAX_ITERATIONS, sparse_solve.DROP_TOLERANCE, False),
+                                                          (0, 0.5, True)])
+def test_positive_definite_solve_agrees_with_a_complete_factorisation(monkeypatch, iterations, drop, falls_back):
+    # The smoothing system of a 30 x 30 grid, 40 right-hand sides (one all
+    # zero), solved as a big system would be. With a crude preconditioner and
+    # no iteration allowed, the complete factorisation answers instead.
+    monkeypatch.setattr(sparse_solve, "COMPLETE_FACTORISATION_LIMIT", 0)
+    monkeypatch.setattr(sparse_solve, "MAX_ITERATIONS", iterations)
+    monkeypatch.setattr(sparse_solve, "DROP_TOLERANCE", drop)
+    complete = []
+    monkeypatch.setattr(sparse_solve, "splu", lambda *args, **kwargs: complete.append(1) or splu(*args, **kwargs))
+    square = grid(30, 30)
+    system = (sp.diags(voronoi_mass(square.vertices, square.triangles))
+              - 0.01 * cotangent_laplacian(square.vertices, square.triangles)).tocsc()
+    rhs = np.random.default_rng(0).random((900, 40))
+    rhs[:, 7] = 0.0
+    solved = sparse_solve.solve_positive_definite(system, rhs)
+    assert bool(complete) == falls_back
+    exact = splu(system).solve(rhs)
+    np.testing.assert_allclose(solved, exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+    assert np.all(solved[:, 7] == 0.0)
+    residual = np.linalg.norm(system @ solved - rhs, axis=0)
+    assert np.all(residual <= sparse_solve.RELATIVE_TOLERANCE * np.linalg.norm(rhs, axis=0))

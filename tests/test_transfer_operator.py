@@ -19,6 +19,7 @@ from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.transfer.options import DEFAULT_MASK_GROUP
 from autorig_addon.core.transfer.transfer import VertexStatus
 from blender_fixtures import (
+    COPY_TOLERANCE,
     BLEND_END,
     BLEND_START,
     LOWER_BONE,
@@ -77,7 +78,7 @@ def test_transfer_selected_sleeve_matches_body_weights(rig, capfd):
     weights = sleeve_weights(rig)
     # The sleeve sits 0.03 off the body, within the match distance: the
     # linear blend is copied (exactly, as the rings line up in height).
-    np.testing.assert_allclose(weights[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    np.testing.assert_allclose(weights[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
     status = status_attribute.read_status_attribute(rig.sleeve)
     assert np.all(status[tube(rig)] == VertexStatus.COPIED)
     # The button floats 0.17 off the body: a part with no match, moving with
@@ -300,7 +301,7 @@ def test_masked_band_is_inpainted_smoothly(rig):
     assert ring_lower[len(heights) // 2] == pytest.approx(0.5, abs=0.02)
     # Outside the band the weights are copied exactly.
     outside = np.setdiff1d(tube(rig), band)
-    np.testing.assert_allclose(weights[outside], expected_body_weights(z[outside]), atol=1e-3)
+    np.testing.assert_allclose(weights[outside], expected_body_weights(z[outside]), atol=COPY_TOLERANCE)
     # The mask group is not a bone: it survives the transfer.
     assert rig.sleeve.vertex_groups.get(DEFAULT_MASK_GROUP) is not None
 
@@ -321,7 +322,7 @@ def test_protected_vertices_keep_their_weights(rig):
     assert np.all(status_attribute.read_status_attribute(rig.sleeve)[protected] == VertexStatus.PROTECTED)
     # Away from the protected rings the body's weights are copied.
     free = tube(rig)[z[tube(rig)] > 0.55]
-    np.testing.assert_allclose(weights[free], expected_body_weights(z[free]), atol=1e-3)
+    np.testing.assert_allclose(weights[free], expected_body_weights(z[free]), atol=COPY_TOLERANCE)
 
 
 def test_mix_blends_with_existing_weights(rig):
@@ -338,7 +339,7 @@ def test_replace_keeps_unrelated_groups_and_replace_all_removes_them(rig):
     assert sorted(g.name for g in rig.sleeve.vertex_groups) == [LOWER_BONE, "Pin", UPPER_BONE]
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", replace_mode="REPLACE_ALL") == {"FINISHED"}
     assert sorted(g.name for g in rig.sleeve.vertex_groups) == [LOWER_BONE, UPPER_BONE]
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
 
 
 def test_bone_subset_only_changes_chosen_bones(rig):
@@ -347,7 +348,7 @@ def test_bone_subset_only_changes_chosen_bones(rig):
     # Lower takes the body's Lower weight, Upper keeps its existing 1, rows renormalised.
     lower = expected_body_weights(tube_heights(rig))[:, 0]
     expected = np.column_stack([lower, np.ones_like(lower)]) / (1.0 + lower)[:, None]
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected, atol=1e-3)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected, atol=COPY_TOLERANCE)
 
 
 def test_selected_pose_bones_subset(rig):
@@ -475,7 +476,7 @@ def test_a_stray_vertex_on_the_target_leaves_the_other_weights_unchanged(rig, ca
     assert (f"Info: {SLEEVE_REPORT}; 1 stray vertex far from the rest of the mesh left out of the transfer and "
             "weighted like the nearest kept vertex\n" in "".join(capfd.readouterr()))
     weights = sleeve_weights(rig)
-    np.testing.assert_allclose(weights[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    np.testing.assert_allclose(weights[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
     # The stray follows its nearest sleeve vertex, at z = 0.5: all Lower.
     np.testing.assert_allclose(weights[-1], [1.0, 0.0], atol=1e-6)
     assert status_attribute.read_status_attribute(rig.sleeve)[-1] == VertexStatus.UNMATCHED_PART
@@ -487,8 +488,11 @@ def test_a_stray_vertex_on_the_source_changes_nothing(rig, capfd):
     capfd.readouterr()
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
     assert (f"Info: {SLEEVE_REPORT}; source 'Body': 1 stray vertex far from the rest of the mesh left out of the "
-            "matching and weighted like the nearest kept vertex\n" in "".join(capfd.readouterr()))
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+            "matching: no weight is copied from it\n" in "".join(capfd.readouterr()))
+    # The source's stray keeps its own weight.
+    stray = len(rig.body.data.vertices) - 1
+    np.testing.assert_allclose(convert.read_weights(rig.body, BONES).matrix[stray], [1.0, 0.0])
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
 
 
 @pytest.mark.parametrize("which", ["Body", "Sleeve"])
@@ -507,7 +511,7 @@ def test_transfer_works_in_weight_paint_and_pose_mode(rig):
     bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
     assert rig.sleeve.mode == "WEIGHT_PAINT"
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
     bpy.ops.object.mode_set(mode="OBJECT")
     rig.sleeve.vertex_groups.clear()
     # The armature in Pose Mode and posed: weights still come from the rest shape.
@@ -515,5 +519,31 @@ def test_transfer_works_in_weight_paint_and_pose_mode(rig):
     bpy.ops.object.mode_set(mode="POSE")
     rig.armature.pose.bones[UPPER_BONE].rotation_quaternion = (0.7071068, 0.7071068, 0.0, 0.0)
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=1e-3)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
     bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_a_bone_subset_that_leaves_vertices_empty_is_refused(rig):
+    """Only Upper on a sleeve with no weights: the lower end (all Lower on
+    the body) would get no weight at all."""
+    z = tube_heights(rig)
+    # The tube's lower end, plus the button, inpainted from the Lower part around it.
+    empty = int(np.count_nonzero(expected_body_weights(z)[:, 1] == 0)) + len(button(rig))
+    assert empty == 200
+    assert_refused_unchanged(
+        rig, f"{empty} vertices of 'Sleeve' get no weight from the chosen bones: "
+        "transfer all bones or select the bones that cover them.",
+        source="Body", targets="Sleeve", bones=UPPER_BONE)
+
+
+def test_a_bone_subset_keeps_existing_weights_where_it_gives_none(rig):
+    # Lower end: all Lower on the body, existing all Upper: replacing Upper alone
+    # would leave nothing; the existing Upper weight stays.
+    preweight_sleeve_upper(rig)
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", bones=UPPER_BONE) == {"FINISHED"}
+    z = tube_heights(rig)
+    expected = expected_body_weights(z)
+    weights = sleeve_weights(rig)[tube(rig)]
+    lower_only = expected[:, 1] == 0
+    np.testing.assert_allclose(weights[lower_only], [[0.0, 1.0]] * int(lower_only.sum()), atol=1e-6)
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)

@@ -178,3 +178,41 @@ def test_binding_replaces_a_bone_parent_keeping_the_world_transform(clean_scene)
     # Carried by the Armature modifier only: never also by the bone.
     assert (rig.sleeve.parent, rig.sleeve.parent_type, rig.sleeve.parent_bone) == (rig.armature, "OBJECT", "")
     np.testing.assert_allclose(evaluated_world_vertices(rig.sleeve), before, atol=1e-6)
+
+
+def test_fill_groups_in_reverse_order_keeps_weights_order_lock_and_active(clean_scene):
+    """Existing groups in the reverse of the written order: every group is
+    rebuilt in place, kept ones with their exact weights."""
+    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
+    box = mesh_object("Box", vertices, faces)
+    names = ["D", "Keep", "C", "B", "A"]
+    for number, name in enumerate(names):
+        box.vertex_groups.new(name=name).add([number], 0.125 * (number + 1), "REPLACE")
+    box.vertex_groups["Keep"].lock_weight = True
+    box.vertex_groups["C"].lock_weight = True
+    box.vertex_groups.active_index = box.vertex_groups["Keep"].index
+    third = float(np.float32(1.0) / np.float32(3.0))
+    weight_writer.fill_groups(box, {name: np.full(8, third) for name in ("A", "B", "C", "D")})
+    assert [group.name for group in box.vertex_groups] == names
+    assert [group.lock_weight for group in box.vertex_groups] == [False, True, True, False, False]
+    assert box.vertex_groups.active.name == "Keep"
+    assert member_weights(box, "Keep") == {1: 0.25}
+    for name in ("A", "B", "C", "D"):
+        assert member_weights(box, name) == {i: third for i in range(8)}
+    assert not any(a.name.startswith("autorig_group_") for a in box.data.attributes)
+
+
+def test_a_failed_conversion_leaves_no_temporary_attribute(clean_scene, monkeypatch):
+    vertices, faces = box_geometry((0.0, 0.0, 0.0), 0.5)
+    box = mesh_object("Box", vertices, faces)
+    attributes_before = sorted(attribute.name for attribute in box.data.attributes)
+
+    class FailingGeometryOps:
+        @staticmethod
+        def attribute_convert(**_):
+            raise RuntimeError("Error: conversion failed\n")
+
+    monkeypatch.setattr(weight_writer.bpy.ops, "geometry", FailingGeometryOps)
+    with pytest.raises(RuntimeError, match="conversion failed"):
+        weight_writer.fill_groups(box, {"A": np.full(8, 0.5)})
+    assert sorted(attribute.name for attribute in box.data.attributes) == attributes_before

@@ -124,11 +124,15 @@ class ObjectSnapshot:
                 bpy.data.meshes.remove(own)
         obj.vertex_groups.clear()
         vertex_count = len(obj.data.vertices)
+        # All groups in one call (one scratch scene): dense, as capture read
+        # them (read_group_weights), so no more memory than capture took.
+        columns = {}
         for state in self.groups:
-            # One group at a time: all of them dense at once could take gigabytes.
             column = np.zeros(vertex_count)
             column[state.indices] = state.weights
-            fill_groups(obj, {state.name: column})
+            columns[state.name] = column
+        fill_groups(obj, columns)
+        for state in self.groups:
             obj.vertex_groups[state.name].lock_weight = state.lock_weight
         if self.groups:
             obj.vertex_groups.active_index = max(self.active_group_index, 0)

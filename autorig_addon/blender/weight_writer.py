@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core.errors import InputError
 from ..core.types import Weights
-from .convert import deform_bone_names, require_armature_object, require_mesh_object
+from .convert import deform_bone_names, read_group_weights, require_armature_object, require_mesh_object
 
 #: Name given to the Armature modifier this add-on creates.
 ARMATURE_MODIFIER_NAME = "Armature"
@@ -71,18 +71,16 @@ def _new_group_from_values(obj, name: str, values: np.ndarray):
     temporary = attribute.name
     attribute.data.foreach_set("value", np.where(values > 0, values, 0.0).astype(np.float32))
     mesh.attributes.active = attribute
-    bpy.ops.geometry.attribute_convert(mode="VERTEX_GROUP")
+    try:
+        bpy.ops.geometry.attribute_convert(mode="VERTEX_GROUP")
+    except BaseException:
+        # A failed conversion must not leave the temporary attribute behind.
+        if mesh.attributes.get(temporary) is not None:
+            mesh.attributes.remove(mesh.attributes[temporary])
+        raise
     group = obj.vertex_groups[temporary]
     group.name = name
     return group
-
-
-def _move_group(obj, source: int, destination: int) -> None:
-    """Move the vertex group at index ``source`` up to index ``destination``
-    (Blender moves a group one place per call); call inside :func:`_operator_context`."""
-    obj.vertex_groups.active_index = source
-    for _ in range(source - destination):
-        bpy.ops.object.vertex_group_move(direction="UP")
 
 
 def fill_groups(obj, values: Mapping[str, np.ndarray]) -> None:
@@ -97,29 +95,39 @@ def fill_groups(obj, values: Mapping[str, np.ndarray]) -> None:
 
     An existing group keeps its place in the list and its lock; new groups
     are appended in the mapping's order; the active group stays active.
+    Groups after the first refilled one are rebuilt with their own weights
+    (one conversion per group, whatever their order); a vertex that was a
+    member of such a kept group with weight 0 is no longer a member.
     """
     if not values:
         return
     groups = obj.vertex_groups
     order = [group.name for group in groups]
-    order += [name for name in values if name not in order]
-    locks = {group.name: group.lock_weight for group in groups if group.name in values}
+    refilled = [index for index, name in enumerate(order) if name in values]
+    # Blender moves a group one place per operator call, so putting refilled
+    # groups back in place would cost O(groups^2) calls when they come in
+    # another order. Instead every group from the first refilled one on is
+    # rebuilt in the list's order, the kept ones with their own weights
+    # read back: one conversion per group whatever the order.
+    start = refilled[0] if refilled else len(order)
+    rebuilt = {name: np.asarray(values[name], dtype=np.float64).reshape(-1) if name in values else None
+               for name in order[start:]}
+    kept = [name for name, weights in rebuilt.items() if weights is None]
+    if kept:
+        for name, column in zip(kept, read_group_weights(obj, kept).T):
+            rebuilt[name] = column
+    rebuilt.update({name: np.asarray(weights, dtype=np.float64).reshape(-1)
+                    for name, weights in values.items() if name not in rebuilt})
+    locks = {group.name: group.lock_weight for group in groups}
     active = groups.active.name if groups.active is not None else None
     attributes = obj.data.attributes
     active_attribute = attributes.active.name if attributes.active is not None else None
-    for name in values:
-        if groups.get(name) is not None:
-            groups.remove(groups[name])
+    for name in order[start:]:
+        groups.remove(groups[name])
     with _operator_context(obj):
-        for name, weights in values.items():
-            group = _new_group_from_values(obj, name, np.asarray(weights, dtype=np.float64).reshape(-1))
+        for name, weights in rebuilt.items():
+            group = _new_group_from_values(obj, name, weights)
             group.lock_weight = locks.get(name, False)
-        # Refilled groups were appended: move each back to its place (one
-        # move per group it passes; none when the refilled groups come last).
-        for index, name in enumerate(order):
-            current = groups[name].index
-            if current != index:
-                _move_group(obj, current, index)
     if active is not None:
         groups.active_index = groups[active].index
     if active_attribute is not None and attributes.get(active_attribute) is not None:

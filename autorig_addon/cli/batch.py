@@ -140,12 +140,17 @@ def check_outputs(outputs: list[Path], summary_file: str | None = None) -> None:
                 f"--out {str(path)!r}: cannot write '{path.suffix or 'extension-less'}' files; "
                 f"use one of {', '.join(SAVABLE_EXTENSIONS)}, or a folder."
             )
-        if path.is_dir():
-            raise UsageError(f"--out {str(path)!r} is a folder; name a file in it.")
+        require_not_folder(path, "--out")
     for folder in sorted({path.parent for path in outputs}):
         check_writable_folder(folder, "--out")
     if summary_file:
         check_writable_folder(Path(summary_file).parent, "--summary")
+
+
+def require_not_folder(path: Path, option: str) -> None:
+    """Raise :class:`UsageError` naming ``option`` when the output file ``path`` is an existing folder."""
+    if Path(path).is_dir():
+        raise UsageError(f"{option} {str(path)!r} is a folder; name a file in it.")
 
 
 def check_writable_folder(folder: Path, option: str) -> None:

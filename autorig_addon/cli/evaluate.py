@@ -61,7 +61,7 @@ from typing import Callable, Optional
 from ..core.dataset.split import DEFAULT_SPLIT_FILE, SUBSETS, DataItem, collect_data
 from ..core.errors import InputError
 from ..core.evaluation.report import markdown_report, summarise
-from .batch import check_writable_folder, stdout_to_stderr
+from .batch import check_writable_folder, require_not_folder, stdout_to_stderr
 from .evaluation_methods import (
     REFERENCE_METHOD,
     SKIN_METHODS,
@@ -252,9 +252,10 @@ def run(args: argparse.Namespace) -> int:
     ------
     UsageError (exit code 2) when the arguments name no file to evaluate,
     an unknown method, an unreadable baseline or an ``--out`` that cannot be
-    written: nothing was run.
+    written (or is a folder): nothing was run.
     """
     if args.out:
+        require_not_folder(Path(args.out), "--out")
         check_writable_folder(Path(args.out).parent, "--out")
     try:
         check_method(args.task, args.method)

@@ -115,7 +115,8 @@ def rig_predictor(method: str) -> Callable:
                           folder / f"{item.path.stem}.txt", folder / f"{item.path.stem}_rig.txt"]
             for candidate in candidates:
                 if candidate.is_file():
-                    return read_rignet_rig(candidate)[0]
+                    # No armature is built: joints at their parent's position are scored as they are.
+                    return read_rignet_rig(candidate, for_armature=False)[0]
             raise InputError(f"No predicted rig for '{item.name}' in '{folder}' (looked for {candidates[0].name}).")
 
         return read_predicted

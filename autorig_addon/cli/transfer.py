@@ -52,6 +52,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         default=defaults.DEFAULT_ACCEPT_FLIPPED_NORMALS,
                         help="Also match opposite normals, for inner layers "
                              f"(default {'on' if defaults.DEFAULT_ACCEPT_FLIPPED_NORMALS else 'off'})")
+    parser.add_argument(
+        "--smoothing-length",
+        type=bounded(float, defaults.MIN_SMOOTHING_LENGTH, defaults.MAX_SMOOTHING_LENGTH),
+        default=defaults.DEFAULT_SMOOTHING_LENGTH,
+        help="Reach of the smoothing of all transferred weights, as a fraction of the source's bounding-box "
+             f"diagonal, {defaults.MIN_SMOOTHING_LENGTH:g} (off) to {defaults.MAX_SMOOTHING_LENGTH:g} "
+             f"(default {defaults.DEFAULT_SMOOTHING_LENGTH:g}: 1 cm on a 2 m body)",
+    )
     add_weight_arguments(parser, defaults.DEFAULT_MAX_INFLUENCES, defaults.DEFAULT_SMOOTHING_ITERATIONS,
                          "Smoothing passes over inpainted vertices", "; 4 for most game engines")
     parser.add_argument("--mask-group", default=defaults.DEFAULT_MASK_GROUP,

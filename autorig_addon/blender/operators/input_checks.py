@@ -47,15 +47,21 @@ def mode_poll(cls, context, label: str) -> bool:
     return True
 
 
-def stray_notes(mesh: Mesh, strays: np.ndarray, action: str) -> dict:
+def stray_notes(mesh: Mesh, strays: np.ndarray, action: str, *, reweighted: bool = True) -> dict:
     """{object name: note} for each object of ``mesh`` with stray vertices
-    (``action``: what they are left out of)."""
+    (``action``: what they are left out of). ``reweighted``: the strays take
+    the weights of their nearest kept vertex (a target's); otherwise (a
+    source's) they keep theirs and no weight is copied from them."""
     notes = {}
     for index, name in enumerate(mesh.object_names):
         count = int(np.count_nonzero(strays[mesh.object_slice(index)]))
         if count:
             what = f"{count} stray vertices" if count > 1 else "1 stray vertex"
-            notes[name] = f"{what} far from the rest of the mesh left out of {action} and weighted like the nearest kept vertex"
+            if reweighted:
+                fate = " and weighted like the nearest kept vertex"
+            else:
+                fate = f": no weight is copied from {'them' if count > 1 else 'it'}"
+            notes[name] = f"{what} far from the rest of the mesh left out of {action}{fate}"
     return notes
 
 

@@ -19,6 +19,7 @@ from ...core.errors import InputError
 from ...core.io.rignet_rig import read_rignet_rig, write_rignet_rig
 from .. import convert
 from ..armature_builder import build_armature
+from ..object_roles import give_own_mesh, shared_mesh_notes
 from ..snapshot import restored_on_failure
 from ..weight_writer import write_weights
 
@@ -37,7 +38,8 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
     at least ``1 - MAX_UNWEIGHTED_SHARE`` of them (vertices without a ``skin``
     line stay unweighted: see :func:`unweighted_vertex_count`).
     All-or-nothing: on failure nothing is left in the scene and the mesh is
-    unchanged.
+    unchanged. A mesh shared with other objects (linked duplicates) gets
+    its own copy first.
     """
     vertex_count = len(mesh_obj.data.vertices) if mesh_obj is not None else None
     skeleton, weights = read_rignet_rig(filepath, vertex_count=vertex_count)
@@ -50,6 +52,9 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
         return armature
     try:
         with restored_on_failure([mesh_obj]):
+            # A linked duplicate gets its own mesh, or the weights would land
+            # on every object sharing it (as skinning and transfer do).
+            give_own_mesh(mesh_obj)
             write_weights(mesh_obj, weights, armature)
     except BaseException:
         data = armature.data
@@ -104,6 +109,7 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         mesh_obj = _active_mesh(context)
+        shared = shared_mesh_notes([mesh_obj]).get(mesh_obj) if mesh_obj is not None else None
         try:
             armature = import_rignet_rig(context, self.filepath, mesh_obj)
         except (InputError, OSError) as error:
@@ -114,7 +120,7 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
             unweighted = unweighted_vertex_count(convert.read_weights(mesh_obj, armature.data.bones.keys()))
             stays = (f" ({unweighted} of its vertices have no weight in the file and stay in place when posed)"
                      if unweighted else "")
-            bound = f", '{mesh_obj.name}' bound{stays}"
+            bound = f", '{mesh_obj.name}' bound{stays}" + (f"; it {shared}" if shared else "")
         self.report({"INFO"}, f"Imported '{armature.name}' with {len(armature.data.bones)} bones{bound}.")
         return {"FINISHED"}
 

@@ -28,6 +28,7 @@ from bpy.props import StringProperty
 from ...core.skinning import geometric as skinning
 from ...core.errors import Cancelled, InputError
 from ...core.progress import ProgressCallback
+from ...core.messages import listed_names
 from ...core.skeleton.tails import TailDecision, with_reliable_tails
 from ...core.types import Mesh, Skeleton, Weights
 from ...core.distances.grid import DEFAULT_RESOLUTION
@@ -148,8 +149,15 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     """
     convert.require_armature_object(armature)
     meshes = list(dict.fromkeys(meshes))
+    found = meshes
     if not named:
         meshes = without_helpers(meshes)
+    if not meshes and found:
+        raise InputError(
+            f"Nothing to skin: the meshes found ({listed_names([obj.name for obj in found], quoted=True)}) are helpers "
+            "(bone shapes, hidden from render). Name the meshes to skin them: --mesh on the command line, "
+            "meshes= from Python."
+        )
     if not meshes:
         raise InputError("Select the mesh(es) to skin together with the armature.")
     check_mode(armature, "skin")

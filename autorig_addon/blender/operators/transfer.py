@@ -30,6 +30,7 @@ from ...core.transfer.combine import (
     REPLACE_ALL,
     check_write_mode,
     combine_with_existing,
+    keep_existing_where_empty,
     needs_existing_weights,
 )
 from ...core.transfer.options import GROUP_MEMBER_THRESHOLD, TransferOptions
@@ -324,7 +325,7 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
     kept_source, source_strays = split_strays(source_mesh)
     notes = {obj: [note] for obj, note in shared_mesh_notes(targets + [b.obj for b in rigid]).items()}
     if source_strays is not None:
-        (source_note,) = stray_notes(source_mesh, source_strays, "the matching").values()
+        (source_note,) = stray_notes(source_mesh, source_strays, "the matching", reweighted=False).values()
         for target in targets:
             notes.setdefault(target, []).append(f"source '{source.name}': {source_note}")
         source_weights = Weights(source_weights.matrix[~source_strays], bone_names)
@@ -399,6 +400,12 @@ def _compute_one(plan: TransferPlan, target, depsgraph, progress: ProgressCallba
     columns = np.array([column_of[name] for name in plan.transferred_bones], dtype=np.int64)
     final = combine_with_existing(existing.matrix, incoming, columns, settings.replace_mode, settings.mix_factor,
                                   settings.options.max_influences)
+    final, unweighted = keep_existing_where_empty(final, existing.matrix)
+    if unweighted.any():
+        raise InputError(
+            f"{int(np.count_nonzero(unweighted))} vertices of '{target.name}' get no weight from the chosen bones: "
+            "transfer all bones or select the bones that cover them."
+        )
     notes = list(plan.notes.get(target, []))
     if strays is not None:
         notes += list(stray_notes(target_mesh, strays, "the transfer").values())
@@ -554,6 +561,7 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             max_distance=self.max_distance if self.use_absolute_distance else None,
             max_normal_angle=math.degrees(self.max_normal_angle),
             accept_flipped_normals=self.accept_flipped_normals,
+            smoothing_length=self.smoothing_length,
             smoothing_iterations=self.smoothing_iterations,
             smoothing_strength=self.smoothing_strength,
             max_influences=self.max_influences,

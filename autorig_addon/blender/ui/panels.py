@@ -82,6 +82,7 @@ class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
         column.prop(settings, "allow_poor_match")
 
         column = layout.column(align=True)
+        column.prop(settings, "smoothing_length")
         column.prop(settings, "smoothing_iterations")
         row = column.row()
         row.active = settings.smoothing_iterations > 0

@@ -85,6 +85,18 @@ class TransferOptionProperties:
         description="Also copy where the normals point the opposite way (inner layers, inward-facing cloth)",
         default=transfer_options.DEFAULT_ACCEPT_FLIPPED_NORMALS,
     )
+    smoothing_length: FloatProperty(
+        name="Smoothing Length",
+        description="Reach of the smoothing of all transferred weights, as a fraction of the source's "
+        "bounding-box diagonal (0 = off; 0.005 is 1 cm on a 2 m body): less stretch where the body's "
+        "weights change abruptly",
+        subtype="FACTOR",
+        min=transfer_options.MIN_SMOOTHING_LENGTH,
+        max=transfer_options.MAX_SMOOTHING_LENGTH,
+        precision=4,
+        step=0.05,
+        default=transfer_options.DEFAULT_SMOOTHING_LENGTH,
+    )
     smoothing_iterations: IntProperty(
         name="Smoothing",
         description="Number of smoothing passes over the inpainted vertices (0 = off)",

@@ -68,7 +68,8 @@ WEIGHT_BYTES = 8
 PathOrText = Union[str, "os.PathLike[str]"]
 
 
-def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None) -> tuple[Skeleton, Optional[Weights]]:
+def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None, *,
+                    for_armature: bool = True) -> tuple[Skeleton, Optional[Weights]]:
     """Parse a RigNet rig file.
 
     Parameters
@@ -80,6 +81,11 @@ def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None
         Number of mesh vertices. Gives the weight matrix that many rows (rows
         without a ``skin`` line are zero) and rejects larger vertex indices.
         Defaults to one more than the largest vertex index in the file.
+    for_armature : bool
+        The rig becomes an armature: a joint at its parent's position (a
+        bone without length or direction) is refused, naming its line.
+        False where only the joints are used (a predicted rig scored by
+        ``eval``), which accepts such joints.
 
     Returns
     -------
@@ -95,7 +101,7 @@ def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None
     InputError
         A file that is not UTF-8 text, malformed lines (with their line
         number), joints beyond :data:`MAX_JOINT_COORDINATE` or at their
-        parent's position, unknown joint names, duplicated joints or
+        parent's position (``for_armature``), unknown joint names, duplicated joints or
         vertices, a joint with two parents, a cycle in the hierarchy, not
         exactly one root, vertex indices beyond :data:`MAX_VERTEX_INDEX` or
         ``vertex_count``, or a weight table larger than the free memory.
@@ -103,7 +109,8 @@ def read_rignet_rig(path_or_text: PathOrText, vertex_count: Optional[int] = None
     text = _text_from_path_or_text(path_or_text)
     records = _parse_records(text)
     order, parents = _sorted_hierarchy(records)
-    _check_joints_apart(records, order, parents)
+    if for_armature:
+        _check_joints_apart(records, order, parents)
     names = tuple(records.joint_names[j] for j in order)
     skeleton = Skeleton(records.joint_positions[order], parents, names)
     if not records.skin_vertices:

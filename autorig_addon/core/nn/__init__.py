@@ -11,8 +11,7 @@ Two twins of every kernel exist:
 
 The rule that keeps torch out of Blender: **only modules inside the
 ``training`` sub-package may import torch, and nothing outside it imports
-from it** (the command line's training subcommand aside, which loads it on
-demand). ``tests/test_core_without_blender.py`` imports every other module
+from it**. ``tests/test_core_without_blender.py`` imports every other module
 in a fresh interpreter and scans their source, and fails when torch or the
 training package is reached; the extension zip leaves the training package
 out (``autorig_addon/packaging.py``).

@@ -39,6 +39,17 @@ class LoadedWeights(NamedTuple):
     metadata: dict
 
 
+#: Permissions a saved weights file gets before the umask: rw-r--r--.
+_NEW_FILE_MODE = 0o644
+
+
+def _current_umask() -> int:
+    """The process's umask (reading it means setting it; it is put back at once)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def save_weights(path: str, weights: dict, metadata: Optional[dict] = None) -> None:
     """Write ``weights`` (and ``metadata``) to ``path``.
 
@@ -74,6 +85,10 @@ def save_weights(path: str, weights: dict, metadata: Optional[dict] = None) -> N
     try:
         with os.fdopen(handle, "wb") as stream:
             np.savez_compressed(stream, **arrays)
+        # mkstemp creates the file readable by its owner alone; a saved file
+        # gets the usual permissions (read and write for the owner, read for
+        # others, less the umask), as open() would give it.
+        os.chmod(temporary, _NEW_FILE_MODE & ~_current_umask())
         os.replace(temporary, path)
     except BaseException:
         if os.path.exists(temporary):
@@ -102,11 +117,14 @@ def load_weights(path: str) -> LoadedWeights:
         raise InputError(f"{path} is not a network weights file ({error}).") from None
     if FORMAT_VERSION_KEY not in arrays or METADATA_KEY not in arrays:
         raise InputError(f"{path} is not a network weights file (no format version or metadata entry).")
-    version = int(arrays.pop(FORMAT_VERSION_KEY))
+    try:
+        version = int(arrays.pop(FORMAT_VERSION_KEY))
+        metadata = json.loads(str(arrays.pop(METADATA_KEY)))
+    except (TypeError, ValueError) as error:  # json.JSONDecodeError is a ValueError
+        raise InputError(f"{path} is not a network weights file (unreadable version or metadata: {error}).") from None
     if version != WEIGHTS_FORMAT_VERSION:
         raise InputError(
             f"{path} holds weights in format {version}, but this add-on reads format {WEIGHTS_FORMAT_VERSION}; "
             "use weights trained for this version of the add-on."
         )
-    metadata = json.loads(str(arrays.pop(METADATA_KEY)))
     return LoadedWeights(arrays, metadata)

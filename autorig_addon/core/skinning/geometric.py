@@ -35,6 +35,20 @@ Steps:
    (:func:`..weights.limit_influences`). Every row is non-empty: loose parts
    take their nearest bone.
 
+Big meshes (more than :data:`PROXY_VERTEX_THRESHOLD` vertices, e.g. sculpt
+resolution) run steps 1 to 3 and the smoothing on a simplified proxy of
+about :data:`PROXY_VERTICES` vertices (:mod:`..geometry.proxy`: vertex
+clustering that keeps every connected part), and the weights come back to
+every vertex interpolated at its closest point on the proxy surface; the
+influence limit, pruning and normalisation run last, on the full mesh
+(smoothing passes run along the proxy's longer edges, so each reaches
+further there). The threshold counts vertices as given, seam copies
+included. The
+cost of the distances and of the diffusion grows with the vertex count
+times the bone count, so a 264k-vertex, 163-bone character drops from
+minutes to seconds (``docs/benchmarks.md``). Smaller meshes are solved
+vertex by vertex, as before.
+
 On the training characters of ``data_split.json`` this halves bone heat's
 mean deformation error; see ``docs/skinning.md`` for the validation table.
 """
@@ -47,6 +61,7 @@ from ..distances.grid import DEFAULT_RESOLUTION
 from ..distances.hollow_dist import hollow_distances
 from ..distances.volumetric_geodesic import volumetric_geodesic_distances
 from ..errors import InputError
+from ..geometry.proxy import Proxy, simplified_proxy
 from ..geometry.segments import paired_point_segment_distances
 from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, smooth_over_edges
 from ..progress import ProgressCallback, report, sub_progress
@@ -77,6 +92,12 @@ DEFAULT_SMOOTHING_ITERATIONS = 0
 #: A vertex sees its nearest bone when its distance through the shape is at
 #: most this much (relative) longer than the straight distance.
 VISIBILITY_SLACK = 0.02
+#: Meshes with more vertices than this are solved on a simplified proxy
+#: (every validation character, at most 13k vertices, stays below it and is
+#: solved vertex by vertex).
+PROXY_VERTEX_THRESHOLD = 20_000
+#: Vertices of that proxy, about (:func:`..geometry.proxy.simplified_proxy`).
+PROXY_VERTICES = 10_000
 
 
 def geometric_weights(
@@ -123,16 +144,27 @@ def geometric_weights(
         raise InputError("The mesh has no vertices.")
     names = tuple(skeleton.names[j] for j in deform)
     heads, tails = skeleton.joints[deform], skeleton.tails[deform]
+    if distances is not None:
+        distances = _checked_distances(distances, mesh.vertex_count, len(deform))
+    proxy = None
+    if mesh.vertex_count > PROXY_VERTEX_THRESHOLD:
+        report(progress, 0.0, "Simplifying the mesh")
+        proxy = simplified_proxy(mesh, PROXY_VERTICES)
+        progress = sub_progress(progress, 0.05, 1.0)
+    solved = mesh if proxy is None else proxy.mesh
     if distances is None:
         compute = volumetric_geodesic_distances if method == "geodesic" else hollow_distances
-        distances = compute(mesh, heads, tails, resolution=resolution, progress=sub_progress(progress, 0.0, 0.85))
-    else:
-        distances = _checked_distances(distances, mesh.vertex_count, len(deform))
+        distances = compute(solved, heads, tails, resolution=resolution, progress=sub_progress(progress, 0.0, 0.85))
+    elif proxy is not None:
+        distances = proxy.average(distances)
     report(progress, 0.9, "Diffusing bone heat")
-    weights = heat_diffusion_weights(mesh, distances, falloff, sees_nearest_bone(mesh.vertices, distances, heads, tails))
-    weights = smooth_over_edges(weights, mesh.triangles, smoothing_iterations, smoothing_strength)
-    weights = prune_small(limit_influences(weights, max_influences))
-    weights = _nearest_bone_where_empty(weights, distances)
+    weights = heat_diffusion_weights(solved, distances, falloff, sees_nearest_bone(solved.vertices, distances, heads, tails))
+    weights = smooth_over_edges(weights, solved.triangles, smoothing_iterations, smoothing_strength)
+    if proxy is None:
+        weights = _nearest_bone_where_empty(_limited(weights, max_influences), lambda empty: distances[empty])
+    else:
+        report(progress, 0.95, "Carrying the weights to every vertex")
+        weights = _carried(proxy, weights, distances, max_influences)
     report(progress, 1.0, "Weights done")
     return Weights(weights, names)
 
@@ -154,17 +186,35 @@ def sees_nearest_bone(vertices: np.ndarray, distances: np.ndarray, heads: np.nda
     return distances[rows, nearest] <= straight * (1.0 + VISIBILITY_SLACK) + 1e-12
 
 
-def _nearest_bone_where_empty(weights: np.ndarray, distances: np.ndarray) -> np.ndarray:
-    """Give any row left without weight its nearest bone (a guard: heat
-    reaches every vertex of a connected part, but pruning could empty a row
-    whose weights were all tiny)."""
+def _limited(weights: np.ndarray, max_influences: int) -> np.ndarray:
+    """At most ``max_influences`` bones per row, negligible weights pruned, rows normalised."""
+    return prune_small(limit_influences(weights, max_influences))
+
+
+def _nearest_bone_where_empty(weights: np.ndarray, empty_distances) -> np.ndarray:
+    """Give any row left without weight its nearest bone, in place (a guard:
+    heat reaches every vertex of a connected part, but pruning could empty
+    a row whose weights were all tiny). ``empty_distances(mask)`` gives the
+    (k, b) distances of the masked rows."""
     empty = empty_rows(weights)
-    if not empty.any():
-        return weights
-    fixed = weights.copy()
-    fixed[empty] = 0.0
-    fixed[np.flatnonzero(empty), distances[empty].argmin(axis=1)] = 1.0
-    return fixed
+    if empty.any():
+        weights[empty] = 0.0
+        weights[np.flatnonzero(empty), empty_distances(empty).argmin(axis=1)] = 1.0
+    return weights
+
+
+def _carried(proxy: Proxy, weights: np.ndarray, distances: np.ndarray, max_influences: int) -> np.ndarray:
+    """(n, b) finished weights of every original vertex from the proxy's
+    unnormalised ``weights`` (p, b), batch by batch so the full mesh's rows
+    exist once (:meth:`..geometry.proxy.Proxy.carry`); an empty row takes
+    the nearest bone by the distances carried the same way."""
+
+    def finish(rows: slice, carried: np.ndarray) -> np.ndarray:
+        interpolation = proxy.interpolation[rows]
+        limited = _limited(carried, max_influences)
+        return _nearest_bone_where_empty(limited, lambda empty: np.asarray(interpolation[np.flatnonzero(empty)] @ distances))
+
+    return proxy.carry(weights, finish)
 
 
 def _checked_distances(distances, vertex_count: int, bone_count: int) -> np.ndarray:

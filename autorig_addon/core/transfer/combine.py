@@ -79,3 +79,53 @@ def combine_with_existing(existing: np.ndarray, incoming: np.ndarray, columns: n
     base = np.zeros_like(existing) if replace_mode == REPLACE_ALL else existing
     combined = mix_weights(normalize_rows(base), normalize_rows(incoming), factor, columns)
     return prune_small(limit_influences(combined, max_influences))
+
+
+#: Largest distance of a written row's sum from 1 (float64 rounding after
+#: normalising, limiting and pruning stays far below it).
+ROW_SUM_TOLERANCE = 1e-6
+
+
+def keep_existing_where_empty(final: np.ndarray, existing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``final`` with no weight at all (a subset of bones, or a mix
+    factor of 0, that leaves a vertex without any) take the vertex's
+    existing row unchanged; rows without any existing weight either are
+    reported, never written empty.
+
+    Parameters
+    ----------
+    final : (n, b) float64 array, from :func:`combine_with_existing`
+    existing : (n, b) float64 array, the target's current weights (raw)
+
+    Returns
+    -------
+    weights : (n, b) float64 array, ``final`` with empty rows replaced by
+        the existing ones
+    unweighted : (n,) bool array, vertices with no weight in either (the
+        caller refuses to write them)
+
+    Raises
+    ------
+    ValueError when a written row is not finite or does not sum to one: a
+    defect, never the user's input.
+
+    Examples
+    --------
+    >>> weights, unweighted = keep_existing_where_empty(
+    ...     np.array([[0.0, 0.0], [0.0, 0.0], [0.5, 0.5]]), np.array([[0.0, 0.3], [0.0, 0.0], [0.0, 1.0]]))
+    >>> weights
+    array([[0. , 0.3],
+           [0. , 0. ],
+           [0.5, 0.5]])
+    >>> unweighted
+    array([False,  True, False])
+    """
+    empty = ~np.any(final > 0, axis=1)
+    had_weight = np.any(existing > 0, axis=1)
+    weights = final.copy()
+    weights[empty] = existing[empty]
+    written = ~empty
+    sums = weights[written].sum(axis=1)
+    if not np.isfinite(weights[written]).all() or np.any(np.abs(sums - 1.0) > ROW_SUM_TOLERANCE):
+        raise ValueError("Combined weights with rows that are not finite or do not sum to one.")
+    return weights, empty & ~had_weight

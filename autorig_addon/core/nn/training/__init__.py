@@ -1,8 +1,7 @@
 """Training the graph networks: the torch twins of the numpy kernels.
 
 Every module in this sub-package may import torch, and only these may:
-nothing the add-on loads inside Blender imports from here (the command
-line's training subcommand loads it on demand), and the extension zip
+nothing the add-on loads inside Blender imports from here, and the extension zip
 leaves this folder out. ``tests/test_core_without_blender.py`` enforces
 both. This ``__init__`` itself imports nothing, so listing the package
 does not load torch.
