@@ -77,15 +77,18 @@ class Matches:
 
 
 def _weights_at(surface: SurfacePoints, source: Mesh, source_weights: np.ndarray,
-                points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Source weights at ``surface``'s closest points of the (q, 3) ``points``.
+                points: np.ndarray, usable: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Source weights at ``surface``'s closest points of the (q, 3) ``points``;
+    ``usable`` (n_s,) bool are the source's usable rows when the caller
+    already has them (:func:`~autorig_addon.core.weights.usable_rows`).
 
     Returns
     -------
     weights : (q, b) float64 array, rows normalised and non-empty (see :attr:`Matches.weights`)
     weighted : (q,) bool array, the closest point carries usable weight
     """
-    usable = usable_rows(source_weights)
+    if usable is None:
+        usable = usable_rows(source_weights)
     if not usable.any():
         raise InputError(f"The source '{source.object_names[0]}' has no vertex with usable weights.")
     clean = np.where(usable[:, None], normalize_rows(source_weights), 0.0)
@@ -123,6 +126,7 @@ def closest_point_weights(source: Mesh, source_weights: Weights, target: Mesh) -
 def match_closest_points(
     source: Mesh, source_weights: np.ndarray, target: Mesh, target_normals: np.ndarray,
     max_distance: float, max_normal_angle: float, accept_flipped_normals: bool,
+    source_usable: np.ndarray | None = None,
 ) -> Matches:
     """Match target vertices whose closest source point is near, carries
     usable weight and has a normal agreeing with the target's.
@@ -139,13 +143,15 @@ def match_closest_points(
         the target normal and the interpolated source normal for a match
     accept_flipped_normals : bool, also match where the normals are opposite
         within the angle (inner layers, cloth modelled facing inwards)
+    source_usable : (n_s,) bool array, optional: the source's usable rows,
+        when the caller has already checked them (computed otherwise)
 
     Returns
     -------
     Matches
     """
     surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    weights, weighted = _weights_at(surface, source, source_weights, target.vertices)
+    weights, weighted = _weights_at(surface, source, source_weights, target.vertices, source_usable)
     source_normals = vertex_normals(source.vertices, source.triangles)
     candidate, flipped = _agreeing(surface, source.triangles, source_normals, target_normals, max_distance,
                                    max_normal_angle, accept_flipped_normals)

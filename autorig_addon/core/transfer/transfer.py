@@ -208,7 +208,7 @@ def transfer_weights(
     welded_normals = vertex_normals(welded_V, welded_F)
     matches = match_closest_points(
         source, source_weights.matrix, welded, welded_normals,
-        max_distance, options.max_normal_angle, options.accept_flipped_normals,
+        max_distance, options.max_normal_angle, options.accept_flipped_normals, source_usable,
     )
     timings["match"] = time.perf_counter() - clock
     matched = matches.matched
