@@ -65,6 +65,20 @@ def test_bone_outside_the_mesh_gets_finite_penalised_distances():
     assert distances[bottom, 0] == pytest.approx(OUTSIDE_JUMP_PENALTY * 0.3 + 1.0, abs=3 * cell)
 
 
+def test_bones_inside_an_open_tube_enter_it_all_along():
+    # An open sleeve encloses no volume, so its bones lie in the air: each
+    # must reach the wall next to it (penalised jump across the radius), not
+    # one entry cell from which every path runs along the wall.
+    mesh = cylinder(radius=0.1, height=2.0, segments=24, rings=41, capped=False)
+    heads, tails = np.array([[0, 0, 0.0], [0, 0, 1.0]]), np.array([[0, 0, 1.0], [0, 0, 2.0]])
+    cell = 2.0 / 88
+    distances = volumetric_geodesic_distances(mesh, heads, tails, resolution=88)
+    z = mesh.vertices[:, 2]
+    for bone, part in ((0, z < 0.8), (1, z > 1.2)):
+        assert np.all(distances[part].argmin(axis=1) == bone)
+        assert distances[part, bone].max() == pytest.approx(OUTSIDE_JUMP_PENALTY * 0.1, abs=4 * cell)
+
+
 def test_disconnected_part_is_reached_from_the_nearest_bone():
     mesh, hat_vertices, heads, tails = body_with_hat()
     cell = 1.3 / 88

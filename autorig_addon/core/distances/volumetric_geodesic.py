@@ -55,6 +55,12 @@ from .line_of_sight import refine_in_sight
 #: A jump through the air from a bone to a solid part it does not cross
 #: counts this many times its straight length.
 OUTSIDE_JUMP_PENALTY = 2.0
+#: A bone enters a part it does not cross at every surface cell at most
+#: this many times as far as the part's nearest one (plus one cell), not
+#: only at the nearest: a bone inside an open tube (a sleeve, a body open at
+#: the neck) is equally near the whole tube, and a single entry would send
+#: every path along the surface from that one cell.
+JUMP_ENTRY_SLACK = 1.5
 #: Cells within this many steps of the surface or of a bone stay out of big
 #: blocks, so paths that bend around the surface or start at a bone keep
 #: full resolution.
@@ -133,7 +139,8 @@ def build_geodesic_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) 
 
 def _jumps_to_uncrossed_parts(grid, nodes, heads, tails, source_bone, source_node):
     """Edges from each bone to every solid part (26-connected component) it
-    does not cross, entering at the part's surface cell nearest the bone.
+    does not cross, entering at the part's surface cells nearest the bone
+    (within :data:`JUMP_ENTRY_SLACK` of the nearest).
 
     The edge costs :data:`OUTSIDE_JUMP_PENALTY` times the jump from the bone
     to that cell's centre, plus the step from the cell to its node's centre
@@ -166,13 +173,14 @@ def _jumps_to_uncrossed_parts(grid, nodes, heads, tails, source_bone, source_nod
         bones = np.flatnonzero(~crossed[part])
         centres = grid.cell_centres(members)
         distances = point_segment_distances(centres, heads[bones], tails[bones])
-        nearest = distances.argmin(axis=0)
-        entry = members[nearest]
+        nearest = distances.min(axis=0)
+        entry_cell, entry_bone = np.nonzero(distances <= nearest * JUMP_ENTRY_SLACK + grid.cell_size)
+        entry = members[entry_cell]
         node = nodes.cell_node[entry[:, 0], entry[:, 1], entry[:, 2]]
-        to_node = np.linalg.norm(nodes.centres[node] - centres[nearest], axis=1)
-        jump_bone.append(bones)
+        to_node = np.linalg.norm(nodes.centres[node] - centres[entry_cell], axis=1)
+        jump_bone.append(bones[entry_bone])
         jump_node.append(node)
-        jump_length.append(OUTSIDE_JUMP_PENALTY * distances[nearest, np.arange(len(bones))] + to_node)
+        jump_length.append(OUTSIDE_JUMP_PENALTY * distances[entry_cell, entry_bone] + to_node)
     if not jump_bone:
         return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     return np.concatenate(jump_bone), np.concatenate(jump_node), np.concatenate(jump_length)
