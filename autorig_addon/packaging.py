@@ -6,13 +6,17 @@ sits at the repository top, so a build stages a temporary directory::
     STAGE/__init__.py, core/, blender/, ...   contents of autorig_addon/ (less the
                                               torch-only core/nn/training/)
     STAGE/blender_manifest.toml               platforms + wheels rewritten
-    STAGE/wheels/*.whl                        the dependencies Blender lacks
+    STAGE/wheels/*.whl                        the dependencies Blender lacks (scipy)
 
 and runs Blender's own extension builder (``blender_ext.py build
 --split-platforms``, shipped inside the ``bpy`` wheel), which also validates
 the manifest. Wheels come from ``pip download`` into a cache that later
 builds reuse. Where each platform's wheels come from is spelled out in
 :data:`PLATFORM_TARGETS`; docs/packaging.md explains it for people.
+
+torch is never shipped: inside Blender the networks run on numpy
+(``core/nn``), and torch only trains them (``core/nn/training``, left out
+of the zip).
 
 Run ``python -m autorig_addon.packaging OUT_DIR [PLATFORM ...]`` from a
 source checkout. Nothing here imports ``bpy``.
@@ -52,12 +56,11 @@ WHEELS_FOLDER = "wheels"
 #: Python of every Blender release we support (4.2 to 5.0 ship CPython 3.11).
 BLENDER_PYTHON_VERSION = "3.11"
 BLENDER_PYTHON_IMPLEMENTATION = "cp"
-TORCH_VERSION = "2.13.0"
-#: PyTorch's own index of CPU-only builds; PyPI's Linux torch is a multi-GB CUDA build.
-PYTORCH_CPU_INDEX_URL = "https://download.pytorch.org/whl/cpu"
-#: Packages torch needs at import time that Blender does not bundle (pure Python).
-#: numpy is not shipped: Blender 4.2+ bundles it.
-TORCH_PURE_PYTHON_DEPENDENCIES = ("typing_extensions", "sympy", "mpmath")
+#: What the add-on imports that Blender does not bundle, shipped at the
+#: versions installed here (the ones the tests ran with). numpy is not
+#: shipped: Blender 4.2+ bundles it. torch is not shipped: it only trains
+#: the networks, which run on numpy inside Blender.
+SHIPPED_DISTRIBUTIONS = ("scipy",)
 #: Default download cache, reused between builds (one sub-folder per platform).
 DEFAULT_WHEEL_CACHE = os.path.join("~", ".cache", "autorig_addon", "wheels")
 #: Add-on folders (relative to ``autorig_addon/``) left out of the extension:
@@ -79,17 +82,13 @@ class WheelRequest:
     Attributes
     ----------
     distribution : str
-        Project name as pip spells it (``"torch"``).
+        Project name as pip spells it (``"scipy"``).
     version : str
-        Exact version, local label included (``"2.13.0+cpu"``).
-    fallback_index_url : str or None
-        Extra index tried only when pip's configured sources (PyPI, the
-        user's ``find-links``) do not have this exact version.
+        Exact version (``"1.17.1"``).
     """
 
     distribution: str
     version: str
-    fallback_index_url: Optional[str] = None
 
     @property
     def requirement(self) -> str:
@@ -106,38 +105,31 @@ class PlatformTarget:
         Blender's platform name (``"linux-x64"``).
     pip_platform_tags : tuple of str
         ``pip download --platform`` tags, most preferred first (oldest OS
-        first, so the widest-compatible wheel wins).
-    torch : WheelRequest
-        The torch build shipped for this platform.
+        first, so the widest-compatible wheel wins); the newest is the
+        oldest OS that both Blender and the shipped wheels allow, so no
+        wheel needing a newer OS can slip in.
     """
 
     blender_platform: str
     pip_platform_tags: tuple
-    torch: WheelRequest
 
 
-#: Every platform we ship. torch 2.13.0 has no macOS x86-64 wheel, so there
-#: is no ``macos-x64`` target.
+#: Every platform we ship; all wheels come from pip's configured sources (PyPI).
 PLATFORM_TARGETS = {
-    # CPU build "2.13.0+cpu": from pip's configured find-links when a copy is
-    # there (CI machines keep one in /opt/wheels), else PyTorch's CPU index.
     "linux-x64": PlatformTarget(
         "linux-x64",
         ("manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux2014_x86_64"),
-        WheelRequest("torch", TORCH_VERSION + "+cpu", PYTORCH_CPU_INDEX_URL),
     ),
-    # PyPI's Windows torch wheel is the CPU build.
-    "windows-x64": PlatformTarget(
-        "windows-x64",
-        ("win_amd64",),
-        WheelRequest("torch", TORCH_VERSION),
+    "windows-x64": PlatformTarget("windows-x64", ("win_amd64",)),
+    # Intel Macs: Blender 4.2 to 5.0 need macOS 11.2; scipy 1.17's wheel is
+    # tagged macosx_10_14.
+    "macos-x64": PlatformTarget(
+        "macos-x64",
+        ("macosx_10_13_x86_64", "macosx_10_14_x86_64", "macosx_10_15_x86_64", "macosx_11_0_x86_64"),
     ),
-    # PyPI's macOS torch wheel is the CPU/MPS build; it needs macOS 14+.
-    "macos-arm64": PlatformTarget(
-        "macos-arm64",
-        ("macosx_11_0_arm64", "macosx_12_0_arm64", "macosx_13_0_arm64", "macosx_14_0_arm64"),
-        WheelRequest("torch", TORCH_VERSION),
-    ),
+    # Apple silicon: scipy 1.17's oldest arm64 wheel is tagged macosx_12_0,
+    # so this package needs macOS 12 (Blender itself runs from 11.2).
+    "macos-arm64": PlatformTarget("macos-arm64", ("macosx_11_0_arm64", "macosx_12_0_arm64")),
 }
 
 
@@ -200,13 +192,12 @@ def build_packages(
 
 
 def wheel_requests(platform: str) -> list[WheelRequest]:
-    """The wheels shipped for ``platform``: scipy at the version installed
-    here (the one the tests ran with), torch as :data:`PLATFORM_TARGETS`
-    says, and torch's pure-Python import-time dependencies at their
-    installed versions."""
+    """The wheels shipped for ``platform``: each of
+    :data:`SHIPPED_DISTRIBUTIONS` at the version installed here (the one the
+    tests ran with); every platform ships the same distributions, in its own
+    build."""
     check_platforms([platform])
-    pure_python = [WheelRequest(name, _installed_version(name)) for name in TORCH_PURE_PYTHON_DEPENDENCIES]
-    return [WheelRequest("scipy", _installed_version("scipy")), PLATFORM_TARGETS[platform].torch, *pure_python]
+    return [WheelRequest(name, _installed_version(name)) for name in SHIPPED_DISTRIBUTIONS]
 
 
 def download_wheels(platform: str, cache_dir: str) -> list[str]:
@@ -404,14 +395,13 @@ def _normalized_distribution(name: str) -> str:
 
 
 def pip_download(request: WheelRequest, platform_tags: Sequence[str], cache_dir: str) -> None:
-    """``pip download`` one wheel for Blender's Python into ``cache_dir``:
-    first from pip's configured sources, then (when the request names one)
-    from its fallback index.
+    """``pip download`` one wheel for Blender's Python into ``cache_dir``
+    from pip's configured sources (PyPI, the user's ``find-links``).
 
     Raises
     ------
     PackagingError
-        Every attempt failed; the message holds the tail of pip's output.
+        pip failed; the message holds the tail of pip's output.
     """
     command = [
         sys.executable, "-m", "pip", "download",
@@ -423,24 +413,18 @@ def pip_download(request: WheelRequest, platform_tags: Sequence[str], cache_dir:
         "--progress-bar", "off",
         request.requirement,
     ]
-    attempts = [command]
-    if request.fallback_index_url:
-        attempts.append(command + ["--extra-index-url", request.fallback_index_url])
-    outputs = []
-    for attempt in attempts:
-        result = subprocess.run(attempt, capture_output=True, text=True, stdin=subprocess.DEVNULL)
-        if result.returncode == 0:
-            return
-        outputs.append(" ".join(attempt[4:]) + "\n" + "\n".join((result.stdout + result.stderr).splitlines()[-8:]))
+    result = subprocess.run(command, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    if result.returncode == 0:
+        return
+    output = " ".join(command[4:]) + "\n" + "\n".join((result.stdout + result.stderr).splitlines()[-8:])
     raise PackagingError(
         f"pip could not download {request.requirement} for platform tags {', '.join(platform_tags)}. "
-        "Check the network (PyPI" + (f" and {request.fallback_index_url}" if request.fallback_index_url else "")
-        + f") or put the wheel into {cache_dir} by hand.\n" + "\n---\n".join(outputs)
+        f"Check the network (PyPI) or put the wheel into {cache_dir} by hand.\n{output}"
     )
 
 
 def _link_or_copy(source: str, destination: str) -> None:
-    # A hard link avoids copying the ~200 MB torch wheel when cache and stage share a disk.
+    # A hard link avoids copying the ~35 MB scipy wheel when cache and stage share a disk.
     try:
         os.link(source, destination)
     except OSError:
