@@ -5,8 +5,9 @@ Usage (from the repo root)::
     .venv/bin/python scripts/render_skinning_docs.py [--out docs/images] [CHARACTER.glb ...]
 
 For each character (default: four validation characters of data_split.json)
-renders, side by side, the artist's weights and the geometric method's, each
-bone in its own colour and vertices coloured by the weight-blended mix.
+renders, side by side, the artist's weights, the geometric method's and the
+default network's (``core.skinning.methods.DEFAULT_SKIN_METHOD``), each bone
+in its own colour and vertices coloured by the weight-blended mix.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from mathutils import Vector  # noqa: E402
 
 from autorig_addon.blender.characters import load_character  # noqa: E402
 from autorig_addon.core.skinning.geometric import geometric_weights  # noqa: E402
+from autorig_addon.core.skinning.learned.predict import learned_weights  # noqa: E402
+from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD  # noqa: E402
 from docs_render import bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render  # noqa: E402
 
 CHARACTERS = os.path.join(REPO, "..", "shared", "data", "characters")
@@ -41,6 +44,7 @@ def render_character(path: str, out_dir: str) -> None:
     character = load_character(path)
     deform = character.skeleton.deform_subset()
     ours = geometric_weights(character.mesh, character.skeleton)
+    learned = learned_weights(character.mesh, character.skeleton, DEFAULT_SKIN_METHOD)
     artist = character.weights.select_bones(deform.names).matrix
     palette = bone_palette(len(deform.names))
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -49,7 +53,8 @@ def render_character(path: str, out_dir: str) -> None:
     lo, hi = vertices.min(0), vertices.max(0)
     setup_render(scene, Vector(((lo + hi) / 2).tolist()), float((hi - lo).max()), direction=(0.7, -1.0, 0.35))
     panels = []
-    for label, weights in (("artist", artist), ("geometric", ours.select_bones(deform.names).matrix)):
+    for label, weights in (("artist", artist), ("geometric", ours.select_bones(deform.names).matrix),
+                           (DEFAULT_SKIN_METHOD, learned.select_bones(deform.names).matrix)):
         obj = mesh_from_arrays(label, vertices, character.mesh.triangles)
         colors = np.clip(weights @ palette, 0, 1)
         colors[:, 3] = 1.0

@@ -2,8 +2,10 @@
 
 import numpy as np
 
+from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.distances.grid import VoxelGrid
 from autorig_addon.core.geometry.subdivision import subdivide_midpoints
+from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 
 
@@ -142,6 +144,37 @@ def body_with_hat():
     heads = np.array([[0, 0, 0.05], [0, 0, 0.6]])
     tails = np.array([[0, 0, 0.6], [0, 0, 0.95]])
     return mesh, np.arange(body.vertex_count, mesh.vertex_count), heads, tails
+
+
+def procedural_sample(seed: int) -> CharacterSample:
+    """The procedural character of ``seed``, normalised as a cached sample
+    (seed 4: a 40-bone chain of 1,086 vertices; seed 5: 30 bones, 762
+    vertices)."""
+    character = generate_character(seed)
+    return CharacterSample.from_character(f"procedural_{seed}", character.kind, character.mesh, character.skeleton,
+                                          character.weights)
+
+
+def random_skin_inputs(seed: int, vertex_count: int, bone_count: int):
+    """Random inputs of ``features.skin_graph``: points in the unit cube with
+    random triangles among all but the last vertex (which has no mesh edge),
+    a random tree of ``bone_count`` bones, distances in [0.01, 1] and a prior
+    whose rows sum to 1 with about half the entries 0.
+
+    Returns
+    -------
+    mesh, skeleton, distances (n, b), prior (n, b)
+    """
+    rng = np.random.default_rng(seed)
+    vertices = rng.uniform(0.0, 1.0, (vertex_count, 3))
+    triangles = np.array([rng.choice(vertex_count - 1, 3, replace=False) for _ in range(vertex_count)])
+    parents = [-1] + [int(rng.integers(0, bone)) for bone in range(1, bone_count)]
+    skeleton = Skeleton(rng.uniform(0.0, 1.0, (bone_count, 3)), parents, tuple(f"b{k}" for k in range(bone_count)),
+                        rng.uniform(0.0, 1.0, (bone_count, 3)))
+    distances = rng.uniform(0.01, 1.0, (vertex_count, bone_count))
+    prior = rng.uniform(0.0, 1.0, (vertex_count, bone_count)) * (rng.random((vertex_count, bone_count)) < 0.5)
+    prior[np.arange(vertex_count), distances.argmin(axis=1)] += 0.1
+    return Mesh(vertices, triangles), skeleton, distances, prior / prior.sum(axis=1, keepdims=True)
 
 
 #: (heads, tails, exact message) of bones every vertex-to-bone distance refuses.

@@ -20,6 +20,7 @@ from autorig_addon.cli.main import SUBCOMMANDS, arguments_from_sys_argv, build_p
 from autorig_addon.core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from autorig_addon.core.geometry.smoothing import MAX_SMOOTHING_ITERATIONS
 from autorig_addon.core.skinning import geometric as skinning
+from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD
 from autorig_addon.core.transfer import options as transfer_options
 from autorig_addon.core.transfer.combine import MIX, REPLACE_ALL
 from autorig_addon.core.transfer.options import TransferOptions
@@ -89,7 +90,7 @@ def test_help_lists_every_subcommand_without_loading_blender(repository_root):
     )
     assert result.returncode == 0, result.stderr
     text = " ".join(result.stdout.split())
-    assert list(SUBCOMMANDS) == ["transfer", "skin", "eval", "package"]
+    assert list(SUBCOMMANDS) == ["transfer", "skin", "eval", "package", "train"]
     for name, subcommand in SUBCOMMANDS.items():
         assert f"{name} {subcommand.help}" in text
 
@@ -136,6 +137,7 @@ def test_arguments_from_sys_argv(argv, expected):
         (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", "fine"], "error: argument --resolution: fine is not an integer"),
         (["skin", "in.blend", *SKIN_ARGUMENTS, "--falloff", "0.05"], "error: argument --falloff: 0.05 is not between 0.1 and 64"),
         (["skin", "in.blend", *SKIN_ARGUMENTS, "--distance", "euclidean"], "error: argument --distance: invalid choice: 'euclidean'"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--method", "magic"], "error: argument --method: invalid choice: 'magic'"),
     ],
 )
 def test_bad_arguments_exit_2_with_the_reason(arguments, message, capsys):
@@ -199,6 +201,7 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     assert (skin.distance.upper(), skin.resolution, skin.max_influences, skin.smoothing_iterations) == (
         settings.skin_distance, settings.skin_resolution, settings.skin_max_influences, settings.skin_smoothing_iterations)
     assert (skin.resolution, skin.distance) == (DEFAULT_RESOLUTION, skinning.DEFAULT_METHOD)
+    assert skin.method.upper() == settings.skin_method and skin.method == DEFAULT_SKIN_METHOD
     assert skin.falloff == pytest.approx(settings.skin_falloff) and skin.falloff == skinning.DEFAULT_FALLOFF
     assert skin.smoothing_strength == pytest.approx(settings.skin_smoothing_strength)
 
@@ -396,9 +399,9 @@ def test_package_download_failure_exits_1(monkeypatch, tmp_path, capsys):
 
 def test_package_unknown_platform_exits_2_before_building(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(packaging, "build_packages", lambda *arguments: pytest.fail("must not build"))
-    code, out, err = run_main(["package", "--out", str(tmp_path), "--platform", "macos-x64"], capsys)
+    code, out, err = run_main(["package", "--out", str(tmp_path), "--platform", "linux-arm64"], capsys)
     assert (code, out) == (2, "")
-    assert err == "error: Unknown platform(s) macos-x64; choose from linux-x64, windows-x64, macos-arm64.\n"
+    assert err == "error: Unknown platform(s) linux-arm64; choose from linux-x64, windows-x64, macos-x64, macos-arm64.\n"
 
 
 # --------------------------------------------------------------------------- scene files

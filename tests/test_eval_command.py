@@ -269,7 +269,8 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("task", "method", "message"),
-    [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'nearest_bone', 'reference']."),
+    [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'heterskinnet', "
+                       "'nearest_bone', 'rignet', 'skinningnet', 'reference']."),
      ("rig", "file:/no/such/folder", "The folder of predicted rigs '/no/such/folder' does not exist."),
      ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of none yet."),
      ("transfer", "copy", "Unknown transfer method 'copy': use one of ['closest_point', 'robust'].")],

@@ -12,7 +12,7 @@ from autorig_addon.core.nn.aggregation import (
     segment_softmax,
     segment_std,
 )
-from autorig_addon.core.nn.convolution import edge_convolution, edge_messages
+from autorig_addon.core.nn.convolution import edge_convolution, edge_messages, multi_aggregator_convolution
 from autorig_addon.core.nn.layers import batch_norm, elu, layer_norm, leaky_relu, linear, mlp, relu
 
 # 4 nodes, 5 edges (not sorted by receiver); node 3 receives nothing.
@@ -125,3 +125,27 @@ def test_edge_convolution_on_a_hand_worked_graph():
     assert edge_convolution(x, edges, weights, "conv.", aggregation="mean", activate_last=False).tolist() == \
         [[2], [-1], [0]]
     assert edge_convolution(x, edges, weights, "conv.", aggregation="min").tolist() == [[1], [0], [0]]
+
+
+def test_multi_aggregator_convolution_on_a_hand_worked_graph():
+    # The graph above: nodes x = 0, 1, 3; edges 1 -> 0, 2 -> 0, 0 -> 1; node 2 receives nothing.
+    x = np.array([[0.0], [1.0], [3.0]])
+    edges = np.array([[1, 2, 0], [0, 0, 1]])
+    # Message weight [0, 1] reads x_j - x_i: node 0 gets 1 and 3, node 1 gets -1.
+    weights = {"maconv.mlp.linears.0.weight": np.array([[0.0, 1.0]]), "maconv.mlp.linears.0.bias": np.zeros(1),
+               "maconv.summary.linears.0.weight": np.eye(4), "maconv.summary.linears.0.bias": np.zeros(4)}
+    # An identity summary shows the pooled (mean, max, min, std) of each node.
+    pooled = multi_aggregator_convolution(x, edges, weights, "maconv.", activation="none")
+    assert pooled.tolist() == [[2, 3, 1, 1], [-1, -1, -1, 0], [0, 0, 0, 0]]
+    # With relu the message -1 becomes 0; the summary then adds the four up and
+    # takes max - min - 0.5: node 0 gives 7 and 1.5, node 1 gives 0 and relu(-0.5).
+    weights["maconv.summary.linears.0.weight"] = np.array([[1.0, 1, 1, 1], [0, 1, -1, 0]])
+    weights["maconv.summary.linears.0.bias"] = np.array([0.0, -0.5])
+    assert multi_aggregator_convolution(x, edges, weights, "maconv.").tolist() == [[7, 1.5], [0, 0], [0, 0]]
+    # Any subset of the aggregators, in the order given: (sum, min) of node 0 is (4, 1).
+    weights["maconv.summary.linears.0.weight"] = np.eye(2)
+    weights["maconv.summary.linears.0.bias"] = np.zeros(2)
+    assert multi_aggregator_convolution(x, edges, weights, "maconv.", aggregations=("sum", "min"),
+                                        activation="none").tolist() == [[4, 1], [-1, -1], [0, 0]]
+    with pytest.raises(KeyError, match="other"):
+        multi_aggregator_convolution(x, edges, weights, "other.")

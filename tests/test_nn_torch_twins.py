@@ -13,10 +13,10 @@ torch = pytest.importorskip("torch")
 
 from autorig_addon.core.nn import aggregation as numpy_aggregation  # noqa: E402
 from autorig_addon.core.nn import layers as numpy_layers  # noqa: E402
-from autorig_addon.core.nn.convolution import edge_convolution  # noqa: E402
+from autorig_addon.core.nn.convolution import edge_convolution, multi_aggregator_convolution  # noqa: E402
 from autorig_addon.core.nn.training import aggregation as torch_aggregation  # noqa: E402
 from autorig_addon.core.nn.training import layers as torch_layers  # noqa: E402
-from autorig_addon.core.nn.training.convolution import EdgeConv, edge_messages  # noqa: E402
+from autorig_addon.core.nn.training.convolution import EdgeConv, MultiAggregatorConv, edge_messages  # noqa: E402
 from autorig_addon.core.nn.training.export import load_module_weights, module_weights, save_module  # noqa: E402
 from autorig_addon.core.nn.training.layers import MLP  # noqa: E402
 from autorig_addon.core.nn.weights_io import load_weights  # noqa: E402
@@ -177,6 +177,30 @@ def test_torch_and_numpy_edge_convolution_agree(aggregation):
     assert result.shape == (NODE_COUNT, 8)
     np.testing.assert_allclose(result, expected, atol=1e-6, rtol=0)
     assert not result[RECEIVING_NODES:].any()
+
+
+@pytest.mark.parametrize("norm, aggregations", [(None, ("mean", "max", "min", "std")), ("layer", ("sum", "std"))])
+def test_torch_and_numpy_multi_aggregator_convolution_agree(norm, aggregations):
+    edges = random_graph(13)
+    x = np.random.default_rng(14).normal(size=(NODE_COUNT, 4)).astype(np.float32)
+    torch.manual_seed(2)
+    layer = MultiAggregatorConv(4, [16, 8], aggregations=aggregations, activation="leaky_relu", norm=norm).eval()
+    expected = layer(torch.from_numpy(x), torch.from_numpy(edges)).detach().numpy()
+    weights = module_weights(layer)
+    assert weights["summary.linears.0.weight"].shape == (8, 8 * len(aggregations))
+    result = multi_aggregator_convolution(x, edges, weights, "", aggregations=aggregations, activation="leaky_relu",
+                                          norm=norm)
+    assert result.shape == (NODE_COUNT, 8) and result.dtype == np.float32
+    np.testing.assert_allclose(result, expected, atol=1e-5, rtol=0)
+    # A node that receives nothing pools zeros, so it gets the summary of 0.
+    empty = multi_aggregator_convolution(np.zeros((1, 4), np.float32), np.zeros((2, 0), np.int64), weights, "",
+                                         aggregations=aggregations, activation="leaky_relu", norm=norm)
+    np.testing.assert_allclose(result[RECEIVING_NODES:], np.repeat(empty, NODE_COUNT - RECEIVING_NODES, axis=0),
+                               atol=1e-6)
+    # Every parameter learns (the std aggregator's gradient included).
+    layer.train()
+    layer(torch.from_numpy(x), torch.from_numpy(edges)).sum().backward()
+    assert all(parameter.grad is not None and parameter.grad.abs().sum() > 0 for parameter in layer.parameters())
 
 
 def test_edge_convolution_equals_the_mlp_of_the_written_out_messages():

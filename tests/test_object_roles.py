@@ -85,8 +85,8 @@ def test_skinning_a_selected_prop_on_a_bone_binds_it_wholly_to_that_bone(clean_s
         pose_bone_turned(armature, UPPER_BONE, TURN_DEGREES)
     select_only([armature, body, helmet], active=armature)
     capfd.readouterr()
-    assert bpy.ops.autorig.skin_weights(skin_resolution=32) == {"FINISHED"}
-    assert ("Info: Skinned 1 mesh(es) to 2 deform bones of 'Armature'; 'Helmet' bound wholly to bone 'Upper' "
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_resolution=32) == {"FINISHED"}
+    assert ("Info: Skinned 1 mesh(es) to 2 deform bones of 'Armature' with Geometric; 'Helmet' bound wholly to bone 'Upper' "
             "(it was parented to that bone)." in "".join(capfd.readouterr()))
     pose_bone_turned(armature, UPPER_BONE, 0.0)
     assert_bound_wholly_to_upper(armature, helmet, moved, rest)

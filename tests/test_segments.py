@@ -7,6 +7,7 @@ from autorig_addon.core.geometry.segments import (
     closest_segments,
     nearest_points_on_segments,
     paired_point_segment_distances,
+    paired_segment_parameters,
     point_segment_distances,
     polyline_arc_lengths,
     segment_parameters,
@@ -34,6 +35,18 @@ def test_paired_distances_match_the_diagonal_of_all_pairs():
     np.testing.assert_allclose(
         paired_point_segment_distances(points, heads, tails), np.diag(point_segment_distances(points, heads, tails)), atol=1e-12
     )
+
+
+def test_paired_parameters_and_distances_by_hand():
+    # Segment i pairs with point i: the third lies beyond the tail, the
+    # fourth before the head, the fifth on a zero-length segment.
+    heads = np.array([[0.0, 0, 0], [0, 0, 0], [0, 0, 0], [1, 1, 1], [2, 2, 2]])
+    tails = np.array([[2.0, 0, 0], [0, 0, 4], [0, 2, 0], [1, 1, 3], [2, 2, 2]])
+    points = np.array([[1.0, 3, 0], [1, 0, 1], [0, 5, 4], [1, 2, 0], [2, 5, 6]])
+    np.testing.assert_allclose(paired_segment_parameters(points, heads, tails), [0.5, 0.25, 1.0, 0.0, 0.0],
+                               atol=1e-15)
+    np.testing.assert_allclose(paired_point_segment_distances(points, heads, tails), [3, 1, 5, np.sqrt(2), 5],
+                               atol=1e-15)
 
 
 def test_closest_segments_by_hand():

@@ -49,7 +49,7 @@ def test_skin_operator_binds_ends_to_their_bones(armature_and_tube, distance):
     import bpy
 
     armature, tube = armature_and_tube
-    assert bpy.ops.autorig.skin_weights(skin_distance=distance, skin_resolution=40) == {"FINISHED"}
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_distance=distance, skin_resolution=40) == {"FINISHED"}
     weights = group_weights(tube, [LOWER_BONE, UPPER_BONE])
     z = np.array([v.co.z for v in tube.data.vertices])
     np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
@@ -135,7 +135,9 @@ def test_zero_length_bone_with_a_child_is_measured_to_the_child(clean_scene):
     tube = unbound_cylinder()
     shrink_bone(armature, LOWER_BONE)
     tails_before = [tuple(bone.tail_local) for bone in armature.data.bones]
-    plan = plan_skin(armature, [tube], SkinSettings(resolution=32), bpy.context.evaluated_depsgraph_get())
+    # The geometric method measures along the derived tail exactly (the networks see it only through features).
+    plan = plan_skin(armature, [tube], SkinSettings(method="geometric", resolution=32),
+                     bpy.context.evaluated_depsgraph_get())
     assert plan.tail_decision.derived == (LOWER_BONE,)
     assert "bone tails derived from the joints" in plan.summary
     lower = plan.skeleton.names.index(LOWER_BONE)
@@ -281,10 +283,11 @@ FAR_AWAY = (10000.0, 0.0, 1.0)
 
 
 def skinned_weights(armature, tube):
+    """The geometric method's weights (its answers on the tube are known exactly)."""
     import bpy
 
     select_only([armature, tube], active=armature)
-    assert bpy.ops.autorig.skin_weights(skin_resolution=40) == {"FINISHED"}
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_resolution=40) == {"FINISHED"}
     return group_weights(tube, [LOWER_BONE, UPPER_BONE])
 
 
@@ -354,7 +357,7 @@ def test_skinning_works_in_weight_paint_and_pose_mode_and_says_why_not_in_edit_m
     # Weight Paint Mode on the mesh, the armature selected (how riggers paint).
     select_only([armature, tube], active=tube)
     bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
-    assert bpy.ops.autorig.skin_weights(skin_resolution=32) == {"FINISHED"}
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_resolution=32) == {"FINISHED"}
     assert tube.mode == "WEIGHT_PAINT"
     in_weight_paint = group_weights(tube, [LOWER_BONE, UPPER_BONE])
     bpy.ops.object.mode_set(mode="OBJECT")
@@ -362,7 +365,7 @@ def test_skinning_works_in_weight_paint_and_pose_mode_and_says_why_not_in_edit_m
     select_only([armature, tube], active=armature)
     bpy.ops.object.mode_set(mode="POSE")
     armature.pose.bones[UPPER_BONE].rotation_quaternion = (0.7071068, 0.7071068, 0.0, 0.0)
-    assert bpy.ops.autorig.skin_weights(skin_resolution=32) == {"FINISHED"}
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_resolution=32) == {"FINISHED"}
     np.testing.assert_allclose(group_weights(tube, [LOWER_BONE, UPPER_BONE]), in_weight_paint, atol=1e-6)
     z = np.array([v.co.z for v in tube.data.vertices])
     assert in_weight_paint[z < 0.3, 0].min() > 0.9 and in_weight_paint[z > 1.7, 1].min() > 0.9

@@ -47,7 +47,8 @@ fraction = bounded(float, 0.0, 1.0)
 
 
 def add_weight_arguments(parser: argparse.ArgumentParser, max_influences: int, smoothing_iterations: int,
-                         smoothing_help: str, max_influences_hint: str = "") -> None:
+                         smoothing_help: str, max_influences_hint: str = "",
+                         smoothing_strength_help: str = "Blend factor of one smoothing pass") -> None:
     """``--max-influences``, ``--smoothing-iterations`` and ``--smoothing-strength``
     with the given defaults, bounded as in the panel."""
     parser.add_argument("--max-influences", type=bounded(int, 0, MAX_INFLUENCES), default=max_influences,
@@ -57,4 +58,4 @@ def add_weight_arguments(parser: argparse.ArgumentParser, max_influences: int, s
                         default=smoothing_iterations,
                         help=f"{smoothing_help}, 0 to {MAX_SMOOTHING_ITERATIONS} (default {smoothing_iterations})")
     parser.add_argument("--smoothing-strength", type=fraction, default=DEFAULT_SMOOTHING_STRENGTH,
-                        help=f"Blend factor of one smoothing pass, 0 to 1 (default {DEFAULT_SMOOTHING_STRENGTH:g})")
+                        help=f"{smoothing_strength_help}, 0 to 1 (default {DEFAULT_SMOOTHING_STRENGTH:g})")

@@ -27,6 +27,8 @@ from typing import Callable
 
 from ..core.dataset.split import DataItem
 from ..core.errors import InputError
+from ..core.skinning.learned.predict import NETWORK_NAMES
+from ..core.skinning.methods import SKIN_METHOD_DESCRIPTIONS
 
 #: Skin method that returns the reference itself: a sanity check of the
 #: pipeline (its scores must be perfect), not a method.
@@ -164,6 +166,17 @@ def _geometric(task: SkinInput):
     return geometric_weights(task.mesh, task.skeleton)
 
 
+def _network(name: str) -> Callable:
+    """The skin method running the shipped network ``name`` (``core.skinning.learned``) with its defaults."""
+
+    def predict(task: SkinInput):
+        from ..core.skinning.learned.predict import learned_weights
+
+        return learned_weights(task.mesh, task.skeleton, name)
+
+    return predict
+
+
 def _closest_point_transfer(source, source_weights, target):
     from ..core.transfer.matching import closest_point_weights
 
@@ -179,5 +192,7 @@ def _robust_transfer(source, source_weights, target):
 register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
 register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
 register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
+for _name in NETWORK_NAMES:
+    register_skin_method(_name, _network(_name), f"{SKIN_METHOD_DESCRIPTIONS[_name]} (core.skinning.learned)")
 register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
 register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")

@@ -1,4 +1,5 @@
-"""Skin weights for meshes and any armature, from voxel distances.
+"""Skin weights for meshes and any armature, by the geometric method or a
+trained network (``core.skinning.methods``).
 
 As with transfer, nothing is written before everything is computed:
 
@@ -26,6 +27,7 @@ import numpy as np
 from bpy.props import StringProperty
 
 from ...core.skinning import geometric as skinning
+from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_LABELS, check_skin_method, skin_weights
 from ...core.errors import Cancelled, InputError
 from ...core.progress import ProgressCallback
 from ...core.messages import listed_names
@@ -54,21 +56,23 @@ SKIN_PROGRESS_TITLE = "Skin weights"
 
 @dataclass(frozen=True)
 class SkinSettings:
-    """Options of a skinning run: the keyword arguments of
-    ``core.skinning.geometric.geometric_weights`` and its defaults, plus how
-    the result is written.
+    """Options of a skinning run: the method and the keyword arguments of
+    ``core.skinning.methods.skin_weights`` with the core's defaults, plus
+    how the result is written.
 
     Attributes
     ----------
-    distance : "geodesic" (volumetric geodesic, RigNet) or "hollow" (HollowDist, HeterSkinNet)
+    method : one of ``core.skinning.methods.SKIN_METHODS``
+    distance : "geodesic" (volumetric geodesic, RigNet) or "hollow" (HollowDist, HeterSkinNet); geometric method only
     resolution : int, voxels along the longest side
-    falloff : float, heat strength (higher: sharper blends)
+    falloff : float, heat strength (higher: sharper blends); geometric method only
     max_influences : int, bones per vertex (0 = no limit)
-    smoothing_iterations : int
-    smoothing_strength : float in [0, 1]
+    smoothing_iterations : int; geometric method only
+    smoothing_strength : float in [0, 1]; geometric method only
     replace_all : bool, remove every existing vertex group first
     """
 
+    method: str = DEFAULT_SKIN_METHOD
     distance: str = skinning.DEFAULT_METHOD
     resolution: int = DEFAULT_RESOLUTION
     falloff: float = skinning.DEFAULT_FALLOFF
@@ -147,6 +151,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         picked them itself (every mesh of a file): helper objects are then
         left out and props on a bone left rigid.
     """
+    check_skin_method(settings.method)
     convert.require_armature_object(armature)
     meshes = list(dict.fromkeys(meshes))
     found = meshes
@@ -198,10 +203,10 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
     if plan.mesh is None:
         names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
         return Weights(np.zeros((0, len(names))), names)
-    weights = skinning.geometric_weights(
-        plan.solved, plan.skeleton, method=s.distance, resolution=int(s.resolution), falloff=float(s.falloff),
-        max_influences=int(s.max_influences), smoothing_iterations=int(s.smoothing_iterations),
-        smoothing_strength=float(s.smoothing_strength), progress=progress,
+    weights = skin_weights(
+        plan.solved, plan.skeleton, s.method, max_influences=int(s.max_influences), resolution=int(s.resolution),
+        progress=progress, distance=s.distance, falloff=float(s.falloff),
+        smoothing_iterations=int(s.smoothing_iterations), smoothing_strength=float(s.smoothing_strength),
     )
     if plan.strays is None:
         return weights
@@ -251,6 +256,7 @@ def _settings_from(props) -> SkinSettings:
     """SkinSettings from the ``skin_*`` properties of the operator or scene settings."""
     values = {name[len("skin_"):]: getattr(props, name) for name in SKIN_OPTION_NAMES}
     values["distance"] = values["distance"].lower()
+    values["method"] = values["method"].lower()
     return SkinSettings(**values)
 
 
@@ -288,7 +294,7 @@ class _SkinJob:
 
 
 class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
-    """Weight the selected meshes to the selected armature from distances through the shape; Esc cancels"""
+    """Weight the selected meshes to the selected armature, by the geometric method or a trained network; Esc cancels"""
 
     bl_idname = "autorig.skin_weights"
     bl_label = "Skin Weights"
@@ -376,7 +382,7 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.report({"INFO"}, f"Skinned {len(plan.meshes)} mesh(es) to {weights.matrix.shape[1]} deform bones of "
-                              f"'{plan.armature.name}'{plan.summary}.")
+                              f"'{plan.armature.name}' with {SKIN_METHOD_LABELS[plan.settings.method]}{plan.summary}.")
         return {"FINISHED"}
 
     def execute(self, context):

@@ -2,6 +2,7 @@
 
 import bpy
 
+from ...core.skinning.methods import GEOMETRIC
 from ..operators.skin import AUTORIG_OT_skin_weights
 from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
 
@@ -122,15 +123,19 @@ class VIEW3D_PT_autorig_skin(_AutoRigSubPanel, bpy.types.Panel):
             column.label(text="Select the meshes and one armature", icon="INFO")
 
         column = layout.column(align=True)
-        column.prop(settings, "skin_distance")
+        column.prop(settings, "skin_method")
         column.prop(settings, "skin_resolution")
-        column.prop(settings, "skin_falloff")
         column.prop(settings, "skin_max_influences")
+        column.prop(settings, "skin_replace_all")
+        # The networks ignore the geometric method's own options.
+        column = layout.column(align=True)
+        column.enabled = settings.skin_method == GEOMETRIC.upper()
+        column.prop(settings, "skin_distance")
+        column.prop(settings, "skin_falloff")
         column.prop(settings, "skin_smoothing_iterations")
         row = column.row()
         row.active = settings.skin_smoothing_iterations > 0
         row.prop(settings, "skin_smoothing_strength")
-        column.prop(settings, "skin_replace_all")
         layout.operator(AUTORIG_OT_skin_weights.bl_idname, icon="MOD_ARMATURE")
 
 

@@ -5,7 +5,7 @@ shared by the scene settings and the operator, so the operator exposes the
 same options to scripts and copies the scene's values when run from the UI.
 
 Defaults and bounds come from the core (``core.transfer.options``,
-``core.transfer.combine``, ``core.skinning.geometric``,
+``core.transfer.combine``, ``core.skinning.geometric``, ``core.skinning.methods``,
 ``core.distances.grid``, ``core.weights``, ``core.geometry.smoothing``),
 where the command line takes them too; only the slider ranges (``soft_*``)
 and the absolute distance, which the panel alone offers, are declared here.
@@ -19,6 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 from ...core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from ...core.geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
 from ...core.skinning import geometric as skinning
+from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_DESCRIPTIONS, SKIN_METHOD_LABELS, SKIN_METHODS
 from ...core.transfer import combine
 from ...core.transfer import options as transfer_options
 from ...core.weights import MAX_INFLUENCES
@@ -162,6 +163,10 @@ class TransferOptionProperties:
 #: The option names shared by the scene settings and the operator.
 TRANSFER_OPTION_NAMES = tuple(TransferOptionProperties.__annotations__)
 
+#: The skinning methods, identifiers upper-case (Blender's habit; the
+#: operator lowers them), labels and tooltips from the core.
+SKIN_METHOD_ITEMS = tuple((name.upper(), SKIN_METHOD_LABELS[name], SKIN_METHOD_DESCRIPTIONS[name])
+                          for name in SKIN_METHODS)
 SKIN_DISTANCE_ITEMS = (
     ("GEODESIC", "Volumetric Geodesic",
      "Shortest path through the inside of the mesh (RigNet, Geodesic Voxel Binding); for closed bodies"),
@@ -173,8 +178,12 @@ SKIN_DISTANCE_ITEMS = (
 class SkinOptionProperties:
     """Skinning options shared by :class:`AutoRigSceneSettings` and the skin operator."""
 
+    skin_method: EnumProperty(
+        name="Method", description="How the weights are computed: the geometric method or a trained network",
+        items=SKIN_METHOD_ITEMS, default=DEFAULT_SKIN_METHOD.upper(),
+    )
     skin_distance: EnumProperty(
-        name="Distance", description="How the distance from a vertex to a bone is measured",
+        name="Distance", description="How the distance from a vertex to a bone is measured (geometric method only)",
         items=SKIN_DISTANCE_ITEMS, default=skinning.DEFAULT_METHOD.upper(),
     )
     skin_resolution: IntProperty(

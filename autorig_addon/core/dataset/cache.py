@@ -36,12 +36,15 @@ RECOMMENDED_VERTEX_RANGE = (1000, 5000)
 MIN_TARGET_VERTICES = 100
 
 
-def default_cache_dir() -> Path:
-    """Folder of cached samples: ``$AUTORIG_CACHE/samples`` or
-    ``~/.cache/autorig_addon/samples``."""
+def cache_root() -> Path:
+    """The cache root: ``$AUTORIG_CACHE`` or ``~/.cache/autorig_addon``."""
     root = os.environ.get(CACHE_ENVIRONMENT_VARIABLE)
-    base = Path(root) if root else DEFAULT_CACHE_ROOT
-    return base.expanduser() / SAMPLES_FOLDER
+    return (Path(root) if root else DEFAULT_CACHE_ROOT).expanduser()
+
+
+def default_cache_dir() -> Path:
+    """Folder of cached samples: ``<cache root>/samples``."""
+    return cache_root() / SAMPLES_FOLDER
 
 
 def file_content_hash(path: str | os.PathLike) -> str:

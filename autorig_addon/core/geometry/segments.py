@@ -67,6 +67,21 @@ def point_segment_distances(points: np.ndarray, heads: np.ndarray, tails: np.nda
     return out
 
 
+def paired_segment_parameters(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
+    """(k,) float64 in [0, 1]: where along the segment ``heads[i]``-``tails[i]``
+    its nearest point to ``points[i]`` lies (0 for a zero-length segment).
+
+    Parameters
+    ----------
+    points, heads, tails : (k, 3) float64 arrays
+    """
+    points, heads, tails = _as_points(points), _as_points(heads), _as_points(tails)
+    direction = tails - heads
+    length_sq = np.einsum("ij,ij->i", direction, direction)
+    projection = np.einsum("ij,ij->i", points - heads, direction)
+    return np.clip(np.divide(projection, length_sq, out=np.zeros_like(projection), where=length_sq > 0), 0.0, 1.0)
+
+
 def paired_point_segment_distances(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
     """(k,) float64 distance from ``points[i]`` to the segment ``heads[i]``-``tails[i]``.
 
@@ -75,12 +90,8 @@ def paired_point_segment_distances(points: np.ndarray, heads: np.ndarray, tails:
     points, heads, tails : (k, 3) float64 arrays
     """
     points, heads, tails = _as_points(points), _as_points(heads), _as_points(tails)
-    relative = points - heads
-    direction = tails - heads
-    length_sq = np.einsum("ij,ij->i", direction, direction)
-    projection = np.einsum("ij,ij->i", relative, direction)
-    t = np.clip(np.divide(projection, length_sq, out=np.zeros_like(projection), where=length_sq > 0), 0.0, 1.0)
-    return np.linalg.norm(relative - t[:, None] * direction, axis=1)
+    t = paired_segment_parameters(points, heads, tails)
+    return np.linalg.norm(points - heads - t[:, None] * (tails - heads), axis=1)
 
 
 def closest_segments(points: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -73,3 +73,34 @@ def edge_convolution(x: np.ndarray, edges: np.ndarray, weights: dict, prefix: st
     messages = mlp(hidden, weights, prefix + "mlp.", activation=activation, norm=norm, activate_last=activate_last,
                    first_linear_applied=True)
     return AGGREGATIONS[aggregation](messages, edges[1], len(x))
+
+
+def multi_aggregator_convolution(x: np.ndarray, edges: np.ndarray, weights: dict, prefix: str, *,
+                                 aggregations: tuple = ("mean", "max", "min", "std"), activation: str = "relu",
+                                 norm: Optional[str] = None) -> np.ndarray:
+    """SkinningNet's Multi-Aggregator Graph Convolution: the EdgeConv
+    messages of :func:`edge_convolution`, reduced by several aggregators
+    whose results are concatenated and summarised by one more MLP.
+
+    Parameters
+    ----------
+    x : (n, c) float array
+    edges : (2, e) int array
+    weights : dict of str -> array, holding ``prefix + "mlp."`` (messages,
+        first layer ``2c`` inputs) and ``prefix + "summary."`` (its input is
+        ``len(aggregations)`` times the message width)
+    prefix : str, the layer's name with its trailing dot
+    aggregations : tuple of keys of :data:`.aggregation.AGGREGATIONS`
+    activation, norm : the MLPs' settings (:func:`.layers.mlp`)
+
+    Returns
+    -------
+    (n, out) float array.
+    """
+    first = prefix + "mlp.linears.0."
+    if first + "weight" not in weights:
+        raise KeyError(f"No convolution named {prefix!r} in the weights (no {first}weight).")
+    hidden = first_layer_per_edge(x, edges, weights[first + "weight"], weights.get(first + "bias"))
+    messages = mlp(hidden, weights, prefix + "mlp.", activation=activation, norm=norm, first_linear_applied=True)
+    pooled = np.concatenate([AGGREGATIONS[name](messages, edges[1], len(x)) for name in aggregations], axis=1)
+    return mlp(pooled, weights, prefix + "summary.", activation=activation, norm=norm)

@@ -137,11 +137,7 @@ def geometric_weights(
     (when that is above 0).
     """
     _check_options(method, falloff, max_influences, smoothing_iterations, smoothing_strength)
-    deform = np.flatnonzero(skeleton.deform)
-    if not len(deform):
-        raise InputError("The armature has no deform bones; enable Deform on the bones that should move the mesh.")
-    if not mesh.vertex_count:
-        raise InputError("The mesh has no vertices.")
+    deform = deform_bones_of(mesh, skeleton)
     names = tuple(skeleton.names[j] for j in deform)
     heads, tails = skeleton.joints[deform], skeleton.tails[deform]
     if distances is not None:
@@ -167,6 +163,22 @@ def geometric_weights(
         weights = _carried(proxy, weights, distances, max_influences)
     report(progress, 1.0, "Weights done")
     return Weights(weights, names)
+
+
+def deform_bones_of(mesh: Mesh, skeleton: Skeleton) -> np.ndarray:
+    """Indices of the deform bones of ``skeleton``, after the checks every
+    skinning method makes.
+
+    Raises
+    ------
+    InputError when there is no deform bone or the mesh has no vertices.
+    """
+    deform = np.flatnonzero(skeleton.deform)
+    if not len(deform):
+        raise InputError("The armature has no deform bones; enable Deform on the bones that should move the mesh.")
+    if not mesh.vertex_count:
+        raise InputError("The mesh has no vertices.")
+    return deform
 
 
 def sees_nearest_bone(vertices: np.ndarray, distances: np.ndarray, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:

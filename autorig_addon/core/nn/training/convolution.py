@@ -55,3 +55,24 @@ class EdgeConv(nn.Module):
         first = self.mlp.linears[0]
         hidden = first_layer_per_edge(x, edges, first.weight, first.bias)
         return self.aggregate(self.mlp(hidden, first_linear_applied=True), edges[1], x.shape[0])
+
+
+class MultiAggregatorConv(nn.Module):
+    """SkinningNet's Multi-Aggregator Graph Convolution (twin of
+    :func:`autorig_addon.core.nn.convolution.multi_aggregator_convolution`):
+    EdgeConv messages reduced by several aggregators, concatenated and
+    summarised by one linear layer and activation (``summary.``)."""
+
+    def __init__(self, in_channels: int, channels: Sequence[int], *,
+                 aggregations: tuple = ("mean", "max", "min", "std"), activation: str = "relu",
+                 norm: Optional[str] = None):
+        super().__init__()
+        self.aggregations = tuple(AGGREGATIONS[name] for name in aggregations)
+        self.mlp = MLP([2 * in_channels, *channels], activation=activation, norm=norm)
+        self.summary = MLP([len(aggregations) * channels[-1], channels[-1]], activation=activation, norm=norm)
+
+    def forward(self, x: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
+        first = self.mlp.linears[0]
+        messages = self.mlp(first_layer_per_edge(x, edges, first.weight, first.bias), first_linear_applied=True)
+        pooled = torch.cat([aggregate(messages, edges[1], x.shape[0]) for aggregate in self.aggregations], dim=1)
+        return self.summary(pooled)

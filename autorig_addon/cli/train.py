@@ -1,0 +1,82 @@
+"""``python -m autorig_addon train``: train the skinning networks.
+
+``train samples`` builds the cached samples of the characters (needs the
+``bpy`` module); ``train skin --model NAME`` trains one network from those
+samples alone (torch, no Blender: it also runs on a machine without bpy)
+and writes its weights where the extension reads them. Fixed seed, so the
+same command gives the same weights on the same device; see
+``docs/models.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from ..core.dataset.cache import default_cache_dir
+from ..core.skinning.learned.predict import NETWORK_NAMES
+from ..core.skinning.learned.training_set import TRAINING_SETTINGS
+from .exit_codes import EXIT_OK
+
+NAME = "train"
+HELP = "Train the skinning networks from cached samples of the training characters"
+
+#: Where the characters of ``data_split.json`` lie, relative to the repository.
+DEFAULT_CHARACTERS = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "characters"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("what", choices=("skin", "samples"),
+                        help="skin: train one skinning network; samples: build the cached samples (needs bpy)")
+    parser.add_argument("--model", choices=NETWORK_NAMES, help="The network to train (train skin)")
+    shipped = ", ".join(f"{name} {epochs} epochs at {rate:g}" for name, (epochs, rate) in TRAINING_SETTINGS.items())
+    parser.add_argument("--epochs", type=int, default=None,
+                        help=f"Epochs (default: the shipped weights' run: {shipped})")
+    parser.add_argument("--learning-rate", type=float, default=None,
+                        help="Adam's starting learning rate (default: the shipped weights' run, see --epochs)")
+    parser.add_argument("--seed", type=int, default=0, help="Random seed (default 0)")
+    parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
+                        help="auto: the GPU when torch sees one (default auto)")
+    parser.add_argument("--samples", type=Path, default=None,
+                        help="Folder of cached samples (default: the cache, ~/.cache/autorig_addon/samples)")
+    parser.add_argument("--examples", type=Path, default=None,
+                        help="Folder of built training examples (default: the cache)")
+    parser.add_argument("--characters", type=Path, default=DEFAULT_CHARACTERS,
+                        help="Folder of the rigged characters (train samples; default ../shared/data/characters)")
+    parser.add_argument("--output", type=Path, default=None,
+                        help="Weights file to write (default: the extension's own, core/skinning/learned/trained/)")
+    parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are")
+
+
+def run(args: argparse.Namespace) -> int:
+    from .exit_codes import UsageError
+
+    samples = args.samples or default_cache_dir()
+    if args.what == "samples":
+        return _build_samples(args.characters, samples)
+    if not args.model:
+        raise UsageError("train skin needs --model " + "|".join(NETWORK_NAMES) + ".")
+    from ..core.nn.training.skin_run import run_training
+
+    record = run_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
+                          seed=args.seed, device=args.device, output=args.output, augment=not args.no_augment,
+                          learning_rate=args.learning_rate)
+    print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out L1 "
+          f"{record['best_l1']:.4f}, {record['seconds']:.0f} s on {record['device']}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _build_samples(characters: Path, samples: Path) -> int:
+    from ..blender.characters import build_character_samples
+    from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
+    from ..core.errors import InputError
+
+    if not characters.is_dir():
+        raise InputError(f"The characters folder '{characters}' does not exist (--characters).")
+    split = read_data_split(DEFAULT_SPLIT_FILE)
+    paths = [characters / path for path in split.subset("all")]
+    built = build_character_samples(paths, cache_dir=samples, root=characters, split=split)
+    print(f"{len(built)} samples in {os.fspath(samples)}", file=sys.stderr)
+    return EXIT_OK
