@@ -12,7 +12,7 @@ from autorig_addon.core.skinning.learned import predict
 from autorig_addon.core.skinning.learned.features import PRIOR_FLOOR, skin_graph
 from autorig_addon.core.skinning.learned.networks import SCORE_FUNCTIONS, candidate_weights
 from autorig_addon.core.types import Mesh, Skeleton
-from geometry_fixtures import cylinder, procedural_sample, random_skin_inputs, subdivided, two_bone_skeleton
+from geometry_fixtures import box_mesh, cylinder, procedural_sample, random_skin_inputs, subdivided, two_bone_skeleton
 
 import torch
 
@@ -217,3 +217,23 @@ def test_learned_weights_of_a_big_mesh_run_on_a_proxy_and_come_back_smoothly():
     jumps = np.abs(weights[edges[0]] - weights[edges[1]]).sum(axis=1)
     assert jumps.max() < SMOOTH_CARRY_MAX_JUMP
     assert np.percentile(jumps, 99) < SMOOTH_CARRY_P99_JUMP
+
+
+@pytest.mark.parametrize("name", ["heterskinnet", "skinningnet"])
+def test_several_objects_a_loose_prop_and_a_bone_outside_the_body_are_all_weighted(name):
+    # A tube (two bones inside), a loose box prop floating beside it, and a
+    # third bone in the air above the tube: every vertex of both objects gets
+    # a full row, and the tube's lower end keeps its own bone (RigNet refuses three bones).
+    tube = cylinder(radius=0.1, height=2.0, rings=21)
+    prop = box_mesh([0.4, -0.1, 1.6], [0.6, 0.1, 1.8], 0.05)
+    mesh = Mesh.concatenate([Mesh(tube.vertices, tube.triangles, object_names=("Tube",)),
+                             Mesh(prop.vertices, prop.triangles, object_names=("Prop",))])
+    skeleton = Skeleton(np.array([[0, 0, 0.0], [0, 0, 1.0], [0, 0, 2.3]]), np.array([-1, 0, 1]),
+                        ("lower", "upper", "floating"), np.array([[0, 0, 1.0], [0, 0, 2.0], [0, 0, 2.6]]),
+                        np.ones(3, dtype=bool))
+    weights = predict.learned_weights(mesh, skeleton, name, resolution=RESOLUTION).matrix
+    assert weights.shape == (mesh.vertex_count, 3)
+    np.testing.assert_allclose(weights.sum(axis=1), 1, atol=1e-12)
+    assert np.isfinite(weights).all() and (weights >= 0).all()
+    lower_end = mesh.vertices[:, 2] < 0.5
+    assert weights[lower_end, 0].mean() > 0.8
