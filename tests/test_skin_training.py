@@ -188,3 +188,15 @@ def test_examples_are_written_once_and_read_back(tmp_path):
     assert training_set.build_examples([sample], "hollow", augment=False, folder=tmp_path) == paths
     assert paths[0].stat().st_mtime_ns == written
     assert [path.name for path in paths[0].parent.iterdir()] == ["procedural_5--rest.npz"]  # no temporary left
+
+
+def test_procedural_samples_are_normalised_characters_named_by_kind_and_seed():
+    from autorig_addon.core.nn.training.skin_run import procedural_samples
+
+    samples = procedural_samples(2)
+    assert [sample.name.split("_")[-1] for sample in samples] == ["0", "1"]
+    for sample in samples:
+        assert sample.name == f"procedural/{sample.category}_{sample.name.split('_')[-1]}"
+        extent = sample.vertices.max(axis=0) - sample.vertices.min(axis=0)
+        assert extent.max() == pytest.approx(1.0, abs=1e-9) and sample.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9)
+        np.testing.assert_allclose(sample.weights.sum(axis=1), 1.0, atol=1e-9)

@@ -48,6 +48,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--output", type=Path, default=None,
                         help="Weights file to write (default: the extension's own, core/skinning/learned/trained/)")
     parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are")
+    parser.add_argument("--procedural", type=int, default=0,
+                        help="Also train on this many procedural characters (seeds 0 to N-1; default 0)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
 
     record = run_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
                           seed=args.seed, device=args.device, output=args.output, augment=not args.no_augment,
-                          learning_rate=args.learning_rate)
+                          learning_rate=args.learning_rate, procedural=args.procedural)
     print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out L1 "
           f"{record['best_l1']:.4f}, {record['seconds']:.0f} s on {record['device']}", file=sys.stderr)
     return EXIT_OK

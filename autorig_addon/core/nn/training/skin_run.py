@@ -63,6 +63,19 @@ def training_samples(sample_dir: Path, split_file: Optional[str] = None) -> list
     return [found[name] for name in sorted(found)]
 
 
+def procedural_samples(count: int) -> list[CharacterSample]:
+    """The procedural characters of seeds ``0 .. count - 1`` as samples
+    (weights from how each piece was built, :mod:`...procedural`)."""
+    from ...procedural import generate_character
+
+    samples = []
+    for seed in range(count):
+        character = generate_character(seed)
+        samples.append(CharacterSample.from_character(f"procedural/{character.kind}_{seed}", character.kind,
+                                                      character.mesh, character.skeleton, character.weights))
+    return samples
+
+
 def pick_device(requested: str) -> str:
     if requested == "auto":
         return "cuda" if torch.cuda.is_available() else "cpu"
@@ -73,7 +86,7 @@ def pick_device(requested: str) -> str:
 
 def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None, epochs: Optional[int] = None,
                  seed: int = 0, device: str = "auto", output: Optional[Path] = None, augment: bool = True,
-                 learning_rate: Optional[float] = None,
+                 learning_rate: Optional[float] = None, procedural: int = 0,
                  split_file: Optional[str] = None) -> dict:
     """Train ``network`` and write its weights; returns the run's record.
     ``epochs`` and ``learning_rate`` default to the network's
@@ -87,6 +100,7 @@ def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path]
     torch.set_num_threads(TRAINING_THREADS)
     samples = training_samples(sample_dir, split_file)
     holdout_names = {sample.name for sample in samples[::HOLDOUT_EVERY]}
+    samples = samples + procedural_samples(procedural)  # never held out: the epoch is chosen on artists' rigs
     train, holdout = [], []
     for sample in samples:
         held = sample.name in holdout_names
@@ -101,7 +115,7 @@ def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path]
                                     learning_rate=learning_rate)
     record.train_examples = len(record.train_examples)
     metadata = record.metadata()
-    metadata.update(distance=distance, augment=augment, torch_version=torch.__version__,
+    metadata.update(distance=distance, augment=augment, procedural=procedural, torch_version=torch.__version__,
                     python=sys.version.split()[0])
     destination = Path(output) if output else trained_weights_path(network)
     destination.parent.mkdir(parents=True, exist_ok=True)
