@@ -200,3 +200,12 @@ def test_procedural_samples_are_normalised_characters_named_by_kind_and_seed():
         extent = sample.vertices.max(axis=0) - sample.vertices.min(axis=0)
         assert extent.max() == pytest.approx(1.0, abs=1e-9) and sample.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9)
         np.testing.assert_allclose(sample.weights.sum(axis=1), 1.0, atol=1e-9)
+
+
+def test_every_network_has_its_shipped_training_settings_and_a_known_prior():
+    assert set(training_set.TRAINING_SETTINGS) == set(predict.NETWORK_NAMES)
+    assert set(predict.NETWORK_PRIORS) == set(predict.NETWORK_NAMES)
+    assert set(predict.NETWORK_PRIORS.values()) <= set(predict.PRIOR_KINDS)
+    mesh, skeleton = procedural_sample(5).mesh, procedural_sample(5).skeleton
+    with pytest.raises(ValueError, match=r"^Unknown prior 'magic'"):
+        predict.network_graph(mesh, skeleton, "hollow", prior="magic", resolution=32)

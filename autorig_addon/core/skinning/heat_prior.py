@@ -25,6 +25,7 @@ from ..geometry.normals import vertex_normals
 from ..geometry.segments import nearest_points_on_segments
 from ..types import Mesh
 from ..weights import limit_influences, prune_small
+from .geometric import DEFAULT_MAX_INFLUENCES
 from .heat_diffusion import heat_diffusion_weights
 
 #: Blender's heat constant (``C_WEIGHT``): heat strength ``1 / d^2``.
@@ -39,8 +40,6 @@ VISIBILITY_SLACK = 0.1
 VISIBILITY_FLOOR = 1e-3
 #: Blender drops weights at or below this (``WEIGHT_LIMIT``).
 WEIGHT_LIMIT = 0.05
-#: Bones kept per vertex.
-MAX_INFLUENCES = 4
 
 
 def heat_prior_weights(mesh: Mesh, heads: np.ndarray, tails: np.ndarray, through: np.ndarray) -> np.ndarray:
@@ -62,4 +61,4 @@ def heat_prior_weights(mesh: Mesh, heads: np.ndarray, tails: np.ndarray, through
     rows, nearest = np.arange(len(vertices)), source.argmin(axis=1)
     visible = through[rows, nearest] <= straight[rows, nearest] * (1.0 + VISIBILITY_SLACK) + VISIBILITY_FLOOR
     weights = heat_diffusion_weights(mesh, source, HEAT_STRENGTH, visible)
-    return prune_small(limit_influences(weights, MAX_INFLUENCES), WEIGHT_LIMIT)
+    return prune_small(limit_influences(weights, DEFAULT_MAX_INFLUENCES), WEIGHT_LIMIT)

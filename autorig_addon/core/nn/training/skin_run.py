@@ -26,7 +26,7 @@ from ...errors import InputError
 from ...nn.weights_io import save_weights
 from ...skinning.learned.predict import NETWORK_PRIORS, network_distance, trained_weights_path
 from ...skinning.learned.training_set import (
-    DEFAULT_EPOCHS, DEFAULT_LEARNING_RATE, TRAINING_SETTINGS, build_examples, load_example,
+    TRAINING_SETTINGS, build_examples, load_example,
 )
 from .skin_training import train_network
 
@@ -92,7 +92,7 @@ def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path]
     ``epochs`` and ``learning_rate`` default to the network's
     :data:`...skinning.learned.training_set.TRAINING_SETTINGS`."""
     distance = network_distance(network)
-    default_epochs, default_rate = TRAINING_SETTINGS.get(network, (DEFAULT_EPOCHS, DEFAULT_LEARNING_RATE))
+    default_epochs, default_rate = TRAINING_SETTINGS[network]
     epochs = default_epochs if epochs is None else epochs
     learning_rate = default_rate if learning_rate is None else learning_rate
     # The graphs are small (about 3,000 vertices): one thread is as fast as

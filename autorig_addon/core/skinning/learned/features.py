@@ -9,7 +9,8 @@ training (from cached samples) and inference (inside Blender):
   examples: where the bone lies relative to the vertex, the distance through
   the shape and the straight one (their ratio says whether something stands
   between them), how much farther the bone is than the vertex's nearest,
-  the prior weight of our geometric method (:mod:`..geometric`);
+  the weight of the prior the network corrects (our geometric method or
+  Blender-style bone heat, :data:`.predict.NETWORK_PRIORS`);
 * **per-vertex features**: position and normal;
 * **per-bone features**: head, tail, direction, length, leaf flag, depth;
 * **graphs**: the mesh one-ring and geodesic balls (RigNet's GMEdgeConv),
@@ -82,7 +83,7 @@ class SkinGraph:
         first (0 where not ``valid``)
     valid : (n, K) bool, False for the missing candidates of a skeleton
         with fewer than K deform bones
-    prior : (n, K) float32, the geometric prior's weights of the candidates
+    prior : (n, K) float32, the prior's weights of the candidates
     bone_features : (d, BONE_FEATURES) float32
     mesh_edges : (2, e) int64, one-ring with self loops
     ball_edges : (2, e') int64, geodesic balls with self loops
@@ -126,7 +127,7 @@ def skin_graph(mesh: Mesh, skeleton: Skeleton, distances: np.ndarray, prior: np.
     skeleton : Skeleton in the same frame; only its deform bones are used
     distances : (n, d) float array, vertex-to-deform-bone distances through
         the shape (volumetric geodesic or HollowDist), same frame
-    prior : (n, d) float array, the geometric method's weights
+    prior : (n, d) float array, the prior's weights (:data:`.predict.NETWORK_PRIORS`)
 
     Returns
     -------

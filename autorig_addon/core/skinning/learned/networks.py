@@ -6,7 +6,8 @@ both give the same weights.
 
 Each network scores every vertex's :data:`.features.CANDIDATE_BONES`
 candidate bones; the scores are *added to* ``prior_scale * log(prior)``, the
-logarithm of our geometric method's weight, so an untrained network
+logarithm of a prior's weight (our geometric method's, or bone heat as
+Blender computes it: :data:`.predict.NETWORK_PRIORS`), so an untrained network
 reproduces the prior and training learns the correction (predicting a
 residual on a geometric prior is what lets these generalise from a few
 dozen characters). A softmax over each vertex's candidates gives weights.

@@ -11,7 +11,7 @@ Steps, for a mesh and any armature (one an artist edited included):
 2. The character is moved into the normalised frame the networks were
    trained in (:func:`...dataset.normalise.normalise`).
 3. The network's distance through the shape (volumetric geodesic or
-   HollowDist, :data:`NETWORK_DISTANCES`) and the geometric method's weights
+   HollowDist, :data:`NETWORK_DISTANCES`) and the prior's weights
    from it (the prior, :func:`..geometric.geometric_weights`).
 4. The network's candidate weights (:mod:`.networks`), spread into the
    (n, d) matrix.
@@ -58,6 +58,8 @@ MIN_DEFORM_BONES = {"rignet": CANDIDATE_BONES}
 #: The prior each network corrects: our geometric method's weights, or bone
 #: heat as Blender computes it (:mod:`..heat_prior`).
 NETWORK_PRIORS = {"rignet": "geometric", "heterskinnet": "heat", "skinningnet": "geometric"}
+#: The priors :func:`network_graph` can build.
+PRIOR_KINDS = ("geometric", "heat")
 #: Names a ``--method`` or the panel accepts for a network.
 NETWORK_NAMES = tuple(NETWORK_DISTANCES)
 #: Folder of the trained weights shipped inside the package, one
@@ -107,7 +109,7 @@ def trained_network(network: str) -> tuple[dict, dict]:
 def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str = "geometric",
                   resolution: int = DEFAULT_RESOLUTION, progress: ProgressCallback | None = None) -> SkinGraph:
     """The inputs of a network for a character already in the normalised
-    frame: its distances, the geometric prior on them, the features.
+    frame: its distances, the prior on them, the features.
 
     Parameters
     ----------
@@ -122,6 +124,8 @@ def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str =
     distances = compute(mesh, skeleton.joints[deform], skeleton.tails[deform], resolution=resolution,
                         progress=sub_progress(progress, 0.0, 0.8))
     report(progress, 0.85, "Geometric prior")
+    if prior not in PRIOR_KINDS:
+        raise ValueError(f"Unknown prior {prior!r}; choose from {PRIOR_KINDS}.")
     if prior == "heat":
         prior_weights = heat_prior_weights(mesh, skeleton.joints[deform], skeleton.tails[deform], distances)
     else:

@@ -49,8 +49,8 @@ TRAINING_SETTINGS = {
     "heterskinnet": (25, 5e-4),
     "skinningnet": (40, 2e-3),
 }
-#: Settings of a network not listed above.
-DEFAULT_EPOCHS = 25
+#: Adam's starting learning rate of :func:`...nn.training.skin_training.train_network`
+#: when not told.
 DEFAULT_LEARNING_RATE = 2e-3
 #: Stretched variants per character.
 STRETCH_VARIANTS = 2
