@@ -17,24 +17,31 @@ METRICS = ("l1", "precision", "recall", "deform_mean", "deform_max", "unweighted
 def main(paths) -> int:
     reports = [json.load(open(path)) for path in paths]
     methods = [report["method"] for report in reports]
-    by_name = [{c["name"]: c for c in report["characters"]} for report in reports]
-    names = [c["name"] for c in reports[0]["characters"]]
     print(f"Each cell: {' / '.join(methods)}. Lower is better except precision and recall.\n")
-    print("| character | category | " + " | ".join(METRICS) + " |")
-    print("|---|---|" + "---|" * len(METRICS))
-    for name in names:
-        cells = [" / ".join(_format(table[name].get(metric)) for table in by_name) for metric in METRICS]
-        print(f"| {name} | {by_name[0][name].get('category', '')} | " + " | ".join(cells) + " |")
-    for label, reduce in (("mean", np.mean), ("median", np.median)):
-        cells = []
-        for metric in METRICS:
-            values = [reduce([table[n][metric] for n in names if metric in table[n]]) for table in by_name]
-            cells.append(" / ".join(_format(v) for v in values))
-        print(f"| **{label}** | | " + " | ".join(cells) + " |")
+    print("\n".join(character_table(reports, METRICS)))
     return 0
 
 
-def _format(value) -> str:
+def character_table(reports, metrics) -> list:
+    """Markdown lines: one row per character of the first report, each
+    metric as ``first / second / ...`` (``-`` where a report did not score
+    it), then the mean and median of each report over the characters it scored."""
+    by_name = [{c["name"]: c for c in report["characters"]} for report in reports]
+    names = [c["name"] for c in reports[0]["characters"]]
+    lines = ["| character | category | " + " | ".join(metrics) + " |", "|---|---|" + "---|" * len(metrics)]
+    for name in names:
+        cells = [" / ".join(format_cell(table.get(name, {}).get(metric)) for table in by_name) for metric in metrics]
+        lines.append(f"| {name} | {by_name[0][name].get('category', '')} | " + " | ".join(cells) + " |")
+    for label, reduce in (("mean", np.mean), ("median", np.median)):
+        cells = []
+        for metric in metrics:
+            values = [[table[n][metric] for n in names if metric in table.get(n, {})] for table in by_name]
+            cells.append(" / ".join(format_cell(reduce(v) if v else None) for v in values))
+        lines.append(f"| **{label}** | | " + " | ".join(cells) + " |")
+    return lines
+
+
+def format_cell(value) -> str:
     if value is None:
         return "-"
     value = float(value)

@@ -344,3 +344,20 @@ def test_package_exports_the_public_names():
     assert dataset.CharacterSample is CharacterSample and dataset.build_samples is build_samples
     assert dataset.read_data_split is read_data_split and dataset.MIN_TARGET_VERTICES == 100
     assert dataset.collect_data is collect_data and dataset.DataItem is DataItem
+
+
+def test_training_samples_are_the_cached_training_side_only(tmp_path, monkeypatch):
+    # Cached: two training characters, one validation character; read by name, sorted.
+    (tmp_path / "split.json").write_text(json.dumps({"train": ["b/y.glb", "a/x.glb"], "validation": ["a/z.glb"]}))
+    for index, name in enumerate(("a/z", "b/y", "a/x")):
+        make_sample(name=name)[0].save(tmp_path / "samples" / f"{index}.npz")
+    found = dataset.training_samples(tmp_path / "samples", str(tmp_path / "split.json"))
+    assert [sample.name for sample in found] == ["a/x", "b/y"]
+    monkeypatch.setenv("AUTORIG_CACHE", str(tmp_path))  # the default folder is <cache root>/samples
+    assert [sample.name for sample in dataset.training_samples(split_file=str(tmp_path / "split.json"))] == ["a/x", "b/y"]
+    (tmp_path / "samples" / "2.npz").unlink()
+    with pytest.raises(InputError, match=(
+        rf"^1 training character\(s\) have no cached sample in '{tmp_path / 'samples'}' \(e\.g\. a/x\); build the "
+        r"samples first: python -m autorig_addon train samples \(needs the bpy module\)\.$"
+    )):
+        dataset.training_samples(tmp_path / "samples", str(tmp_path / "split.json"))

@@ -14,6 +14,7 @@ from autorig_addon.core.evaluation.skeleton_metrics import (
     merge_coincident_joints,
     sample_bones,
 )
+from autorig_addon.core.geometry.bounding_box import bounding_box_diagonal, largest_side
 from autorig_addon.core.types import Skeleton
 from geometry_fixtures import small_humanoid
 
@@ -172,3 +173,14 @@ def test_evaluate_rig_rejects_bad_input():
         chamfer_j2j(np.zeros((2, 2)), np.zeros((1, 3)))
     with pytest.raises(InputError, match="The bone sample spacing must be positive, got 0.0"):
         sample_bones(np.zeros((1, 2, 3)), 0.0)
+
+
+def test_eval_rig_unit_is_the_largest_side_not_the_diagonal():
+    # A character in a 2 x 1 x 0.5 box (largest side 2, diagonal 2.29) whose
+    # two predicted joints are each 0.1 off: CD-J2J = 0.1 / 2 = 0.05 in
+    # RigNet's unit, not 0.1 / 2.29 = 0.0436.
+    box = np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 0.5]])
+    ref = skeleton([[1.0, 0.5, 0.0], [1.0, 0.5, 0.5]], [-1, 0])
+    pred = skeleton(ref.joints + [0.1, 0.0, 0.0], [-1, 0])
+    assert evaluate_rig(pred, ref, largest_side(box))["cd_j2j"] == pytest.approx(0.05)
+    assert 0.1 / bounding_box_diagonal(box) == pytest.approx(0.0436, abs=1e-4)

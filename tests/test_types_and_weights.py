@@ -3,7 +3,7 @@ import pytest
 import scipy.sparse as sp
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.geometry.bounding_box import bounding_box_diagonal, character_size, checked_size
+from autorig_addon.core.geometry.bounding_box import bounding_box_diagonal, character_size, checked_size, largest_side
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 from autorig_addon.core.weights import (
     empty_rows,
@@ -66,6 +66,15 @@ def test_bounding_box_diagonal_of_a_mesh_and_of_points():
     assert character_size(points) == pytest.approx(13.0)
     assert bounding_box_diagonal(np.zeros((0, 3))) == 0.0
     assert Mesh(np.zeros((0, 3)), np.zeros((0, 3), int)).bounding_box_diagonal == 0.0
+
+
+def test_largest_side_of_points():
+    # The same box, 3 x 4 x 12: its largest side is 12 whichever axis holds it.
+    points = np.array([[0.0, 0.0, 0.0], [3.0, 4.0, 0.0], [1.0, 1.0, 12.0]])
+    assert largest_side(points) == 12.0
+    assert largest_side(points[:, [2, 0, 1]] - 7.0) == 12.0
+    assert largest_side(np.zeros((0, 3))) == 0.0
+    assert largest_side(np.ones((4, 3))) == 0.0
 
 
 def test_character_size_must_be_positive():

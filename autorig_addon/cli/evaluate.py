@@ -35,7 +35,11 @@ skin
     the reference. Vertices the *reference* leaves unweighted are not scored.
 rig
     ``cd_j2j``, ``cd_j2b``, ``cd_b2b``, ``iou``, ``precision``, ``recall``,
-    ``tree_edit`` on deform bones, joints at the same place merged.
+    ``tree_edit`` on deform bones, joints at the same place merged;
+    distances (and the joint matching tolerance) in units of the largest
+    side of the character's bounding box, as RigNet reports them. A
+    method's notes (e.g. which training character the
+    ``nearest_character`` baseline chose) join the loader's.
 transfer
     DATA files without an armature are garments: weights come from the body
     given by ``--source`` and are scored by edge stretch under the poses
@@ -130,11 +134,13 @@ def evaluate_rig_item(item: DataItem, method: str) -> dict:
     """Load one character, predict its rig from the mesh alone and score it."""
     from ..blender.characters import load_character
     from ..core.evaluation.skeleton_metrics import evaluate_rig
+    from ..core.geometry.bounding_box import largest_side
 
     character = load_character(item.path, item.name, item.category)
     predicted, seconds = _predict_timed(rig_predictor(method), character.mesh, item)
-    return {**evaluate_rig(predicted, character.skeleton, character.size), "seconds": seconds,
-            "notes": list(character.notes)}
+    # RigNet's unit: the largest side of the bounding box, not the diagonal the skin metrics use.
+    scores = evaluate_rig(predicted.skeleton, character.skeleton, largest_side(character.mesh.vertices))
+    return {**scores, "seconds": seconds, "notes": list(character.notes) + list(predicted.notes)}
 
 
 @dataclass

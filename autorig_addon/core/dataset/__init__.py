@@ -21,6 +21,7 @@ from .cache import (
     file_content_hash,
     sample_cache_key,
     sample_path,
+    training_samples,
 )
 from .normalise import (
     FACING_AS_NAMED,

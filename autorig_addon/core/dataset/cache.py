@@ -5,7 +5,9 @@ Samples are cached under ``$AUTORIG_CACHE/samples`` (default
 build parameters, so a changed file or setting makes a new sample and
 rebuilding is reproducible. Loading the characters needs Blender
 (``blender.characters``); :func:`build_samples` takes the loader as an
-argument, so everything here works on arrays.
+argument, so everything here works on arrays. :func:`training_samples`
+reads the cached samples of the split's training characters (training runs
+and the ``nearest_character`` baseline of ``eval rig``).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import Callable, Iterable, Optional
 from ..errors import InputError
 from ..progress import ProgressCallback, report
 from .sample import SAMPLE_FORMAT_VERSION, CharacterSample
+from .split import DEFAULT_SPLIT_FILE, read_data_split
 
 #: Environment variable naming the cache root (samples go to ``<root>/samples``).
 CACHE_ENVIRONMENT_VARIABLE = "AUTORIG_CACHE"
@@ -158,3 +161,37 @@ def build_samples(
         samples.append(sample)
     report(progress, 1.0, "Samples ready")
     return samples
+
+
+def training_samples(sample_dir: str | os.PathLike | None = None, split_file: Optional[str] = None) -> list[CharacterSample]:
+    """The cached samples of the split's training characters, sorted by name.
+
+    Parameters
+    ----------
+    sample_dir : folder, optional
+        Default :func:`default_cache_dir`.
+    split_file : path of ``data_split.json``, optional
+        Default :data:`~.split.DEFAULT_SPLIT_FILE`.
+
+    Raises
+    ------
+    InputError when some are missing (build them with ``eval`` or
+    ``blender.characters.build_character_samples``: that needs Blender).
+    """
+    sample_dir = Path(sample_dir) if sample_dir is not None else default_cache_dir()
+    split = read_data_split(split_file or DEFAULT_SPLIT_FILE)
+    wanted = {os.path.splitext(path)[0] for path in split.train}
+    found = {}
+    for path in sorted(sample_dir.glob("*.npz")):
+        try:
+            sample = CharacterSample.load(path)
+        except InputError:
+            continue  # a sample of an older format; the builder replaces it
+        if sample.name in wanted:
+            found[sample.name] = sample
+    missing = sorted(wanted - set(found))
+    if missing:
+        raise InputError(
+            f"{len(missing)} training character(s) have no cached sample in '{sample_dir}' (e.g. {missing[0]}); "
+            "build the samples first: python -m autorig_addon train samples (needs the bpy module).")
+    return [found[name] for name in sorted(found)]

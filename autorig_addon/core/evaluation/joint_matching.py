@@ -13,9 +13,10 @@ from scipy.optimize import linear_sum_assignment
 from ..errors import InputError
 
 #: A predicted joint matches a reference joint within this share of the
-#: character size. RigNet uses half the local shape diameter at the
-#: reference joint; for a 1.7 m human in A-pose (bounding-box diagonal about
-#: 2 m) this is 5 cm, about half the thickness of an upper arm.
+#: character size (``eval rig``: the largest side of its bounding box).
+#: RigNet uses half the local shape diameter at the reference joint; for a
+#: 1.7 m human in A-pose (largest side 1.7 m) this is 4.3 cm, about half the
+#: thickness of an upper arm.
 JOINT_MATCH_FRACTION = 0.025
 
 

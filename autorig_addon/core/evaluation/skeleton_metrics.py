@@ -16,8 +16,8 @@ counts as a zero-length bone so that it is not ignored.
 :func:`evaluate_rig` first keeps only deform bones
 (:meth:`Skeleton.deform_subset`) and merges joints at the same place
 (:func:`merge_coincident_joints`); it reports distances in units of the
-character's size, which callers take as the bounding-box diagonal of the rest
-mesh (:func:`~..geometry.bounding_box.character_size`).
+character's size, which ``eval rig`` takes as RigNet does: the largest side
+of the rest mesh's bounding box (:func:`~..geometry.bounding_box.largest_side`).
 """
 
 from __future__ import annotations
@@ -161,7 +161,7 @@ def chamfer_j2j(pred_joints: np.ndarray, ref_joints: np.ndarray, size: float = 1
     """
     pred_joints = checked_joints(pred_joints, "predicted joints")
     ref_joints = checked_joints(ref_joints, "reference joints")
-    return _symmetric_chamfer(pred_joints, ref_joints) / checked_size(size)
+    return symmetric_chamfer(pred_joints, ref_joints) / checked_size(size)
 
 
 def chamfer_j2b(pred: Skeleton, ref: Skeleton, size: float = 1.0) -> float:
@@ -208,7 +208,7 @@ def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fracti
     spacing = spacing_fraction * size
     pred_points = sample_bones(bone_segments(pred), spacing)
     ref_points = sample_bones(bone_segments(ref), spacing)
-    return _symmetric_chamfer(pred_points, ref_points) / size
+    return symmetric_chamfer(pred_points, ref_points) / size
 
 
 def evaluate_rig(
@@ -228,7 +228,8 @@ def evaluate_rig(
     pred, ref : Skeleton
         In the same space as the character's mesh.
     size : float
-        The character's size: bounding-box diagonal of its rest mesh.
+        The character's size: the largest side of its rest mesh's bounding
+        box in ``eval rig`` (RigNet's unit).
     match_fraction : float
         Joint matching tolerance of IoU/precision/recall
         (:func:`~.joint_matching.joint_iou_precision_recall`), share of ``size``.
@@ -271,7 +272,18 @@ def _joint_bone_distances(joints: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     return point_segment_distances(joints, segments[:, 0], segments[:, 1])
 
 
-def _symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray) -> float:
+def symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray) -> float:
+    """Symmetric Chamfer distance ``(mean_a min_b |a - b| + mean_b min_a |b - a|) / 2``.
+
+    Parameters
+    ----------
+    points_a : (p, 3) float64 array, p >= 1
+    points_b : (q, 3) float64 array, q >= 1
+
+    Returns
+    -------
+    distance : float, in the units of the points
+    """
     a_to_b = cKDTree(points_b).query(points_a)[0].mean()
     b_to_a = cKDTree(points_a).query(points_b)[0].mean()
     return float(a_to_b + b_to_a) / 2.0

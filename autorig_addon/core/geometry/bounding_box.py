@@ -1,7 +1,10 @@
-"""The size of a point set: the diagonal of its axis-aligned bounding box.
+"""The size of a point set: the diagonal of its axis-aligned bounding box,
+or its largest side.
 
 Every length the add-on scales by the size of a character (error
-measures, tolerances, weld distances) uses this one measure.
+measures, tolerances, weld distances) uses the diagonal, except where a
+published measure fixes another unit: RigNet's skeleton metrics (``eval
+rig``) and its normalisation use the largest side (:func:`largest_side`).
 """
 
 from __future__ import annotations
@@ -27,10 +30,35 @@ def bounding_box_diagonal(points: np.ndarray) -> float:
     >>> bounding_box_diagonal([[0, 0, 0], [3, 4, 0], [1, 1, 12]])
     13.0
     """
+    return float(np.linalg.norm(_box_sides(points)))
+
+
+def largest_side(points: np.ndarray) -> float:
+    """Length of the longest side of the axis-aligned bounding box of ``points``.
+
+    Parameters
+    ----------
+    points : (n, 3) float64 array
+
+    Returns
+    -------
+    side : float, in the units of ``points``; 0 for no points
+
+    Examples
+    --------
+    >>> largest_side([[0, 0, 0], [3, 4, 0], [1, 1, 12]])
+    12.0
+    """
+    return float(_box_sides(points).max())
+
+
+def _box_sides(points: np.ndarray) -> np.ndarray:
+    """(3,) float64 side lengths of the axis-aligned bounding box of (n, 3)
+    ``points`` along x, y, z; zeros for no points."""
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if not len(points):
-        return 0.0
-    return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        return np.zeros(3)
+    return points.max(axis=0) - points.min(axis=0)
 
 
 def character_size(vertices: np.ndarray) -> float:

@@ -13,15 +13,14 @@ weights file: what ``python -m autorig_addon train skin`` does.
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 from typing import Optional
 
 import torch
 
+from ...dataset.cache import training_samples
 from ...dataset.sample import CharacterSample
-from ...dataset.split import DEFAULT_SPLIT_FILE, read_data_split
 from ...errors import InputError
 from ...nn.weights_io import save_weights
 from ...skinning.learned.predict import NETWORK_PRIORS, network_distance, trained_weights_path
@@ -35,32 +34,6 @@ from .skin_training import train_network
 HOLDOUT_EVERY = 6
 #: CPU threads torch trains with.
 TRAINING_THREADS = 1
-
-
-def training_samples(sample_dir: Path, split_file: Optional[str] = None) -> list[CharacterSample]:
-    """The cached samples of the split's training characters, sorted by name.
-
-    Raises
-    ------
-    InputError when some are missing (build them with ``eval`` or
-    ``blender.characters.build_character_samples``: that needs Blender).
-    """
-    split = read_data_split(split_file or DEFAULT_SPLIT_FILE)
-    wanted = {os.path.splitext(path)[0] for path in split.train}
-    found = {}
-    for path in sorted(Path(sample_dir).glob("*.npz")):
-        try:
-            sample = CharacterSample.load(path)
-        except InputError:
-            continue  # a sample of an older format; the builder replaces it
-        if sample.name in wanted:
-            found[sample.name] = sample
-    missing = sorted(wanted - set(found))
-    if missing:
-        raise InputError(
-            f"{len(missing)} training character(s) have no cached sample in '{sample_dir}' (e.g. {missing[0]}); "
-            "build the samples first: python -m autorig_addon train samples (needs the bpy module).")
-    return [found[name] for name in sorted(found)]
 
 
 def procedural_samples(count: int) -> list[CharacterSample]:

@@ -1,0 +1,1 @@
+"""Skeleton prediction from a bare mesh (RigNet-style): joints, connectivity, names."""
