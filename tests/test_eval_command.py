@@ -38,6 +38,8 @@ from blender_fixtures import (
 )
 
 BODY_SIZE = math.sqrt((2 * BODY_RADIUS) ** 2 * 2 + BODY_HEIGHT ** 2)
+#: ``eval rig``'s unit (RigNet's): the largest side of the body's bounding box, its height.
+BODY_LARGEST_SIDE = max(2 * BODY_RADIUS, BODY_HEIGHT)
 #: The reference skeleton of the fixture body, as the subcommand reads it.
 SKELETON = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], (LOWER_BONE, UPPER_BONE), [[0, 0, 1], [0, 0, 2]])
 SKIN_KEYS = {"name", "category", "path", "l1", "precision", "recall", "deform_mean", "deform_max", "unweighted",
@@ -201,9 +203,9 @@ def test_rig_from_files_equal_to_the_reference(clean_scene, tmp_path, capsys):
         0.0, 0.0, 1.0, 1.0, 1.0, 0)
     _, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{shifted}"], tmp_path, capsys)
     (entry,) = report["characters"]
-    # Every joint is 0.05 from its counterpart: the Chamfer distance is 0.05 / size.
-    assert entry["cd_j2j"] == pytest.approx(0.05 / BODY_SIZE, rel=1e-6)
-    assert entry["iou"] == 1.0  # within the matching tolerance of 0.025 * size
+    # Every joint is 0.05 from its counterpart: the Chamfer distance is 0.05 / largest side (2.0), not / diagonal.
+    assert entry["cd_j2j"] == pytest.approx(0.05 / BODY_LARGEST_SIDE, rel=1e-6)
+    assert entry["iou"] == 1.0  # at the matching tolerance of 0.025 * 2.0 = 0.05
     code, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{tmp_path}"], tmp_path, capsys)
     assert code == 1
     assert report["characters"][0]["error"] == f"No predicted rig for 'body' in '{tmp_path}' (looked for body.txt)."
@@ -272,7 +274,7 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
     [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'heterskinnet', "
                        "'nearest_bone', 'rignet', 'skinningnet', 'reference']."),
      ("rig", "file:/no/such/folder", "The folder of predicted rigs '/no/such/folder' does not exist."),
-     ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of none yet."),
+     ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of ['nearest_character', 'rignet']."),
      ("transfer", "copy", "Unknown transfer method 'copy': use one of ['closest_point', 'robust'].")],
 )
 def test_unknown_methods_are_usage_errors(task, method, message, tmp_path, capsys):

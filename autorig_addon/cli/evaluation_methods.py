@@ -8,7 +8,8 @@ gets and returns, per task:
 skin
     ``predict(SkinInput) -> Weights`` over the deform bones.
 rig
-    ``predict(mesh: Mesh) -> Skeleton`` in the world space of the mesh.
+    ``predict(mesh: Mesh) -> Skeleton`` in the world space of the mesh, or
+    a :class:`RigPrediction` when the method has notes for the report.
 transfer
     ``predict(source_mesh, source_weights, target_mesh) -> Weights``.
 
@@ -21,7 +22,9 @@ not load Blender.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Callable
 
@@ -52,6 +55,20 @@ class SkinInput:
     mesh: object
     skeleton: object
     armature_name: str = ""
+
+
+@dataclass(frozen=True)
+class RigPrediction:
+    """What a rig method gives: the skeleton and notes for the report.
+
+    Attributes
+    ----------
+    skeleton : core.types.Skeleton, world space of the mesh
+    notes : tuple of str, e.g. which training character a baseline chose
+    """
+
+    skeleton: object
+    notes: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -99,7 +116,7 @@ def method_names(task: str) -> list[str]:
 
 
 def rig_predictor(method: str) -> Callable:
-    """``predict(mesh, item: DataItem) -> Skeleton`` for a rig method name.
+    """``predict(mesh, item: DataItem) -> RigPrediction`` for a rig method name.
 
     Raises
     ------
@@ -118,14 +135,19 @@ def rig_predictor(method: str) -> Callable:
             for candidate in candidates:
                 if candidate.is_file():
                     # No armature is built: joints at their parent's position are scored as they are.
-                    return read_rignet_rig(candidate, for_armature=False)[0]
+                    return RigPrediction(read_rignet_rig(candidate, for_armature=False)[0])
             raise InputError(f"No predicted rig for '{item.name}' in '{folder}' (looked for {candidates[0].name}).")
 
         return read_predicted
     if method not in RIG_METHODS:
-        raise InputError(f"Unknown rig method '{method}': use {FILE_METHOD_PREFIX}DIR or one of {sorted(RIG_METHODS) or 'none yet'}.")
+        raise InputError(f"Unknown rig method '{method}': use {FILE_METHOD_PREFIX}DIR or one of {sorted(RIG_METHODS)}.")
     predict = RIG_METHODS[method].predict
-    return lambda mesh, item: predict(mesh)
+
+    def predict_rig(mesh, item: DataItem) -> RigPrediction:
+        result = predict(mesh)
+        return result if isinstance(result, RigPrediction) else RigPrediction(result)
+
+    return predict_rig
 
 
 def check_method(task: str, method: str) -> None:
@@ -177,6 +199,34 @@ def _network(name: str) -> Callable:
     return predict
 
 
+@lru_cache(maxsize=1)
+def _nearest_character_pool() -> tuple:
+    """The cached samples of the training characters of the repository's
+    ``data_split.json`` (``--split-file`` does not reach a registered method),
+    read once per process; its validation characters are left out by name
+    whatever the cache holds."""
+    from ..core.dataset.cache import training_samples
+    from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
+
+    validation = {os.path.splitext(path)[0] for path in read_data_split(DEFAULT_SPLIT_FILE).validation}
+    return tuple(sample for sample in training_samples() if sample.name not in validation), frozenset(validation)
+
+
+def _nearest_character(mesh) -> RigPrediction:
+    from ..core.rigging.nearest_character import nearest_character
+
+    pool, validation = _nearest_character_pool()
+    chosen = nearest_character(mesh, pool, exclude=validation)
+    return RigPrediction(chosen.skeleton, (chosen.note,))
+
+
+def _rignet_skeleton(mesh) -> RigPrediction:
+    from ..core.rigging.predict import predict_votes, skeleton_from_votes
+
+    votes = predict_votes(mesh)
+    return RigPrediction(skeleton_from_votes(votes), votes.notes)
+
+
 def _closest_point_transfer(source, source_weights, target):
     from ..core.transfer.matching import closest_point_weights
 
@@ -194,5 +244,15 @@ register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its c
 register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
 for _name in NETWORK_NAMES:
     register_skin_method(_name, _network(_name), f"{SKIN_METHOD_DESCRIPTIONS[_name]} (core.skinning.learned)")
+register_rig_method(
+    "nearest_character", _nearest_character,
+    "the learning-free baseline: the training character with the closest normalised surface (Chamfer), "
+    "its skeleton fitted to the mesh's bounding box (core.rigging.nearest_character); samples from the cache",
+)
+register_rig_method(
+    "rignet", _rignet_skeleton,
+    "the skeleton predictor with its defaults: joint network, mean shift, bone and root networks "
+    "(core.rigging.predict)",
+)
 register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
 register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")

@@ -16,21 +16,28 @@ import sys
 from pathlib import Path
 
 from ..core.dataset.cache import default_cache_dir
+from ..core.rigging.predict import NETWORK_FILES
 from ..core.skinning.learned.predict import NETWORK_NAMES
 from ..core.skinning.learned.training_set import TRAINING_SETTINGS
 from .exit_codes import EXIT_OK
 
+#: The skeleton networks ``train rig --model`` trains.
+RIG_NETWORK_NAMES = tuple(NETWORK_FILES)
+
 NAME = "train"
-HELP = "Train the skinning networks from cached samples of the training characters"
+HELP = "Train the skinning and skeleton networks from cached samples of the training characters"
 
 #: Where the characters of ``data_split.json`` lie, relative to the repository.
 DEFAULT_CHARACTERS = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "characters"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("what", choices=("skin", "samples"),
-                        help="skin: train one skinning network; samples: build the cached samples (needs bpy)")
-    parser.add_argument("--model", choices=NETWORK_NAMES, help="The network to train (train skin)")
+    parser.add_argument("what", choices=("skin", "rig", "samples"),
+                        help="skin: train one skinning network; rig: train one skeleton network; samples: build the "
+                             "cached samples (needs bpy)")
+    parser.add_argument("--model", choices=NETWORK_NAMES + RIG_NETWORK_NAMES,
+                        help=f"The network to train: train skin {'|'.join(NETWORK_NAMES)}; "
+                             f"train rig {'|'.join(RIG_NETWORK_NAMES)}")
     shipped = ", ".join(f"{name} {epochs} epochs at {rate:g}" for name, (epochs, rate) in TRAINING_SETTINGS.items())
     parser.add_argument("--epochs", type=int, default=None,
                         help=f"Epochs (default: the shipped weights' run: {shipped})")
@@ -58,7 +65,9 @@ def run(args: argparse.Namespace) -> int:
     samples = args.samples or default_cache_dir()
     if args.what == "samples":
         return _build_samples(args.characters, samples)
-    if not args.model:
+    if args.what == "rig":
+        return _train_rig(args, samples)
+    if args.model not in NETWORK_NAMES:
         raise UsageError("train skin needs --model " + "|".join(NETWORK_NAMES) + ".")
     from ..core.nn.training.skin_run import run_training
 
@@ -67,6 +76,22 @@ def run(args: argparse.Namespace) -> int:
                           learning_rate=args.learning_rate, procedural=args.procedural)
     print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out L1 "
           f"{record['best_l1']:.4f}, {record['seconds']:.0f} s on {record['device']}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _train_rig(args: argparse.Namespace, samples: Path) -> int:
+    from .exit_codes import UsageError
+
+    if args.model not in RIG_NETWORK_NAMES:
+        raise UsageError("train rig needs --model " + "|".join(RIG_NETWORK_NAMES) + ".")
+    from ..core.nn.training.rig_run import run_rig_training
+
+    record = run_rig_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
+                              learning_rate=args.learning_rate, seed=args.seed, device=args.device,
+                              output=args.output)
+    print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out "
+          f"{'CD-J2J' if args.model == 'joints' else 'loss'} {record['best_score']:.4f}, {record['seconds']:.0f} s "
+          f"on {record['device']}", file=sys.stderr)
     return EXIT_OK
 
 

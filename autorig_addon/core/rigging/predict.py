@@ -1,0 +1,270 @@
+"""A skeleton for a bare character mesh, RigNet's way (Xu et al. 2020).
+
+1. :func:`predict_votes` (the slow part, about a second): the mesh's
+   triangles are simplified to a proxy of :data:`.joint_features.PROXY_VERTICES`
+   vertices, moved into RigNet's normalised frame (feet at z = 0, largest
+   side 1), checked for orientation, and the joint network moves every
+   vertex toward its joint and weighs its vote (:mod:`.joint_network`).
+2. :func:`skeleton_from_votes` (fast, so the level-of-detail slider answers
+   at once): attention-weighted mean shift of the votes at the chosen
+   *bandwidth* (:mod:`.mean_shift`), mirrored across the character's plane
+   and paired when the shape is symmetric (:mod:`.symmetry`), bones from a
+   spanning tree over learned bone probabilities and a learned root
+   (:mod:`.connectivity`), names by role (:mod:`.role_names`), tails for
+   the leaves, and back to the mesh's own space.
+
+The character is expected upright along +Z, facing -Y, its left at +X
+(Blender's front view). One facing +-X is recognised by its mirror plane and
+turned for the network; one lying on its side is refused with a message.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..dataset.normalise import apply_transform, normalisation_transform
+from ..errors import InputError
+from ..geometry.proxy import simplified_proxy
+from ..nn.weights_io import load_weights
+from ..progress import ProgressCallback, report
+from ..skeleton.tails import derived_tails
+from ..types import Mesh, Skeleton
+from .connectivity import (
+    bone_probabilities, candidate_pairs, oriented_tree, pair_features, root_features, root_scores, spanning_tree,
+)
+from .joint_features import PROXY_VERTICES, SolidDepth, joint_graph, solid_depth
+from .joint_network import joint_outputs
+from .mean_shift import mean_shift_modes
+from .role_names import role_names
+from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
+
+#: Mean-shift bandwidth, share of the character's largest side: the level
+#: of detail (smaller: more joints). The default, with the density
+#: threshold's, has the lowest CD-J2J on the held-out training characters
+#: (0.0393; ``scripts/tune_rig_clustering.py``, docs/models.md) and finds
+#: 0.86 times as many joints as the artists drew.
+DEFAULT_BANDWIDTH = 0.02
+MIN_BANDWIDTH = 0.01
+MAX_BANDWIDTH = 0.2
+#: Modes with less vote density than this share of the strongest are not joints.
+DEFAULT_DENSITY_THRESHOLD = 0.02
+MIN_DENSITY_THRESHOLD = 0.0
+MAX_DENSITY_THRESHOLD = 1.0
+#: Mirror votes and pair joints when the shape is left-right symmetric.
+DEFAULT_SYMMETRY = True
+#: Joints this close to the mirror plane, or to their twin's mirror image,
+#: are snapped (share of the bandwidth).
+SNAP_SHARE = 0.5
+#: Fewest faces a mesh needs: below this there is no shape to read.
+MIN_FACES = 16
+#: Length of a bone the tree gives no direction (a lone joint), share of
+#: the largest side, pointing up; also the shortest a leaf is cut to.
+LONE_BONE_LENGTH = 0.02
+#: A leaf bone ends at this share of the way to where its line leaves the
+#: solid, so its tail stays inside the body.
+LEAF_INSIDE_SHARE = 0.8
+#: Points sampled along a leaf bone to find where it leaves the solid.
+LEAF_SAMPLES = 16
+#: The shipped weights of the three networks.
+TRAINED_FOLDER = Path(__file__).resolve().parent / "trained"
+NETWORK_FILES = {"joints": "joints.npz", "bones": "bones.npz", "root": "root.npz"}
+
+
+@dataclass(frozen=True)
+class JointVotes:
+    """The joint network's output for one character, kept so that clustering
+    again at another bandwidth needs no network.
+
+    Attributes
+    ----------
+    points : (n, 3) float64, votes (moved proxy vertices), normalised frame
+    attention : (n,) float64 in (0, 1)
+    solid : SolidDepth of the normalised proxy
+    transform : (4, 4) float64, from the mesh's space to the normalised frame
+    symmetric : bool, whether the shape is left-right symmetric
+    notes : tuple of str, what was detected or decided
+    """
+
+    points: np.ndarray
+    attention: np.ndarray
+    solid: SolidDepth
+    transform: np.ndarray
+    symmetric: bool
+    notes: tuple = ()
+
+
+def trained_weights_path(network: str) -> Path:
+    return TRAINED_FOLDER / NETWORK_FILES[network]
+
+
+@lru_cache(maxsize=None)
+def trained_network(network: str) -> dict:
+    """The shipped weights of ``joints``, ``bones`` or ``root``."""
+    path = trained_weights_path(network)
+    if not path.is_file():
+        raise InputError(f"The trained {network} network is missing ({path}); reinstall the extension.")
+    return load_weights(str(path)).weights
+
+
+def facing_turns(vertices: np.ndarray) -> int:
+    """Quarter turns that bring the character's mirror plane to x = 0.
+
+    Raises
+    ------
+    InputError when the character lies on its side (symmetric top to bottom
+    but not left to right).
+    """
+    errors = [mirror_error(vertices, axis) for axis in range(3)]
+    across_x, across_y, across_z = errors
+    if across_x > SYMMETRY_TOLERANCE and across_y < CLEARLY_BETTER * across_x:
+        return 1
+    if across_z < SYMMETRY_TOLERANCE and min(across_x, across_y) > 2 * SYMMETRY_TOLERANCE:
+        raise InputError("The character seems to lie on its side (it is mirror-symmetric top to bottom, not left to "
+                         "right): stand it upright along +Z, facing -Y, and predict again.")
+    return 0
+
+
+def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> JointVotes:
+    """Run the joint network on ``mesh`` (see the module docstring).
+
+    Parameters
+    ----------
+    mesh : Mesh, one or more objects forming one character, any space
+    progress : optional ProgressCallback (may raise Cancelled)
+
+    Raises
+    ------
+    InputError for a mesh with too few faces or lying on its side.
+    """
+    if len(mesh.triangles) < MIN_FACES:
+        raise InputError(f"The mesh has {len(mesh.triangles)} faces; predicting a skeleton needs a character "
+                         f"surface of at least {MIN_FACES}.")
+    weights = trained_network("joints")
+    report(progress, 0.0, "Simplifying the mesh")
+    used = np.unique(mesh.triangles)
+    remap = np.zeros(mesh.vertex_count, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    surface = Mesh(mesh.vertices[used], remap[mesh.triangles])
+    if not np.all(np.isfinite(surface.vertices)):
+        raise InputError("The mesh has vertices at NaN or infinite positions; fix them before predicting a skeleton.")
+    proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
+    transform = normalisation_transform(proxy.vertices)
+    notes = []
+    turns = facing_turns(apply_transform(proxy.vertices, transform))
+    if turns:
+        transform = normalisation_transform(proxy.vertices, turns)
+        notes.append("The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 "
+                     "of its own space).")
+    normalised = Mesh(apply_transform(proxy.vertices, transform), proxy.triangles)
+    symmetric = mirror_error(normalised.vertices, 0) <= SYMMETRY_TOLERANCE
+    if not symmetric:
+        notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
+    report(progress, 0.3, "Measuring the shape")
+    solid = solid_depth(normalised)
+    graph = joint_graph(normalised, solid)
+    report(progress, 0.6, "Running the joint network")
+    offsets, attention = joint_outputs(weights, graph)
+    report(progress, 1.0, "Joint votes done")
+    return JointVotes(graph.vertices + offsets, attention, solid, transform, symmetric, tuple(notes))
+
+
+def cluster_joints(votes: JointVotes, bandwidth: float, density_threshold: float,
+                   symmetry: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Joints of the votes in the normalised frame and each one's twin (-1: none)."""
+    points, weights = votes.points, votes.attention
+    mirrored = symmetry and votes.symmetric
+    if mirrored:
+        points = np.concatenate([points, mirror_points(points)])
+        weights = np.concatenate([weights, weights])
+    joints, _ = mean_shift_modes(points, weights, bandwidth, density_threshold)
+    if mirrored and len(joints):
+        return symmetric_joints(joints, SNAP_SHARE * bandwidth)
+    return joints, np.full(len(joints), -1, dtype=np.int64)
+
+
+def connect_joints(joints: np.ndarray, mirror: np.ndarray, solid: SolidDepth) -> tuple[np.ndarray, np.ndarray]:
+    """A parents-first order of the joints and the parents in that order."""
+    count = len(joints)
+    pairs = candidate_pairs(joints)
+    probabilities = (bone_probabilities(trained_network("bones"), pair_features(joints, pairs, solid, mirror))
+                     if len(pairs) else np.zeros(0))
+    edges = spanning_tree(count, pairs, probabilities, mirror, joints)
+    scores = root_scores(trained_network("root"), root_features(joints, solid))
+    midline = mirror < 0
+    if np.any(mirror >= 0) and midline.any():
+        scores = np.where(midline, scores, -np.inf)
+    return oriented_tree(count, edges, int(np.argmax(scores)))
+
+
+def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWIDTH,
+                        density_threshold: float = DEFAULT_DENSITY_THRESHOLD,
+                        symmetry: bool = DEFAULT_SYMMETRY) -> Skeleton:
+    """The skeleton of the votes at a level of detail, in the mesh's space.
+
+    Parameters
+    ----------
+    votes : JointVotes of :func:`predict_votes`
+    bandwidth : float in [MIN_BANDWIDTH, MAX_BANDWIDTH], share of the largest side
+    density_threshold : float in [0, 1]
+    symmetry : bool, mirror and pair when the shape is symmetric
+
+    Returns
+    -------
+    Skeleton, every bone deforming, parents first, names unique.
+    """
+    if not MIN_BANDWIDTH <= bandwidth <= MAX_BANDWIDTH:
+        raise InputError(f"The bandwidth must be between {MIN_BANDWIDTH} and {MAX_BANDWIDTH}, got {bandwidth}.")
+    if not MIN_DENSITY_THRESHOLD <= density_threshold <= MAX_DENSITY_THRESHOLD:
+        raise InputError(f"The density threshold must be between {MIN_DENSITY_THRESHOLD} and "
+                         f"{MAX_DENSITY_THRESHOLD}, got {density_threshold}.")
+    joints, mirror = cluster_joints(votes, bandwidth, density_threshold, symmetry)
+    if not len(joints):
+        raise InputError("No joint was found: lower the density threshold.")
+    order, parents = connect_joints(joints, mirror, votes.solid)
+    joints = joints[order]
+    position = np.empty_like(order)
+    position[order] = np.arange(len(order))
+    mirror = np.where(mirror[order] >= 0, position[np.maximum(mirror[order], 0)], -1)
+    names = role_names(joints, parents, mirror)
+    tails = leaf_tails_inside(joints, parents, derived_tails(joints, parents), votes.solid)
+    to_mesh = np.linalg.inv(votes.transform)
+    return Skeleton(apply_transform(joints, to_mesh), parents, names, apply_transform(tails, to_mesh))
+
+
+def leaf_tails_inside(joints: np.ndarray, parents: np.ndarray, tails: np.ndarray, solid: SolidDepth) -> np.ndarray:
+    """Tails with each leaf cut where its line would leave the body.
+
+    A leaf continues its parent's direction for the parent's length
+    (:func:`...skeleton.tails.derived_tails`), which pokes out of a head or
+    a fingertip; it is cut to :data:`LEAF_INSIDE_SHARE` of the way to the
+    first point of the line outside the solid, and no shorter than
+    :data:`LONE_BONE_LENGTH`. A bone without a direction points up.
+    """
+    tails = np.array(tails, dtype=np.float64)
+    lone = ~np.isfinite(tails).all(axis=1)
+    tails[lone] = joints[lone] + np.array([0.0, 0.0, LONE_BONE_LENGTH])
+    leaves = np.flatnonzero(np.bincount(parents[parents >= 0], minlength=len(joints)) == 0)
+    if not len(leaves):
+        return tails
+    offsets = tails[leaves] - joints[leaves]
+    steps = np.linspace(1.0 / LEAF_SAMPLES, 1.0, LEAF_SAMPLES)
+    along = joints[leaves, None, :] + steps[None, :, None] * offsets[:, None, :]
+    outside = solid.at(along.reshape(-1, 3)).reshape(len(leaves), LEAF_SAMPLES) <= 0.0
+    first_outside = np.where(outside.any(axis=1), steps[outside.argmax(axis=1)], np.inf)
+    length = np.linalg.norm(offsets, axis=1)
+    share = np.minimum(1.0, LEAF_INSIDE_SHARE * first_outside)
+    share = np.maximum(share, np.minimum(1.0, LONE_BONE_LENGTH / np.maximum(length, 1e-12)))
+    tails[leaves] = joints[leaves] + share[:, None] * offsets
+    return tails
+
+
+def predict_skeleton(mesh: Mesh, *, bandwidth: float = DEFAULT_BANDWIDTH,
+                     density_threshold: float = DEFAULT_DENSITY_THRESHOLD, symmetry: bool = DEFAULT_SYMMETRY,
+                     progress: ProgressCallback | None = None) -> Skeleton:
+    """:func:`predict_votes` then :func:`skeleton_from_votes`."""
+    votes = predict_votes(mesh, progress)
+    return skeleton_from_votes(votes, bandwidth=bandwidth, density_threshold=density_threshold, symmetry=symmetry)

@@ -1,0 +1,63 @@
+"""Pick the mean-shift defaults of the skeleton predictor on the held-out
+training characters (never the validation ones).
+
+Usage (from the repo root, after ``train rig --model joints``)::
+
+    .venv/bin/python scripts/tune_rig_clustering.py
+
+Runs the shipped joint network once per held-out character (the ones
+``train rig`` holds out to pick its epoch) and prints, for a grid of
+bandwidths and density thresholds, the mean CD-J2J of the clustered joints
+and the mean joint IoU against the artists' joints (units of the largest
+side; RigNet's metrics, ``core.evaluation``).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from autorig_addon.core.dataset.cache import training_samples  # noqa: E402
+from autorig_addon.core.evaluation.joint_matching import JOINT_MATCH_FRACTION, joint_iou_precision_recall  # noqa: E402
+from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j  # noqa: E402
+from autorig_addon.core.nn.training.rig_run import default_examples_dir  # noqa: E402
+from autorig_addon.core.nn.training.skin_run import HOLDOUT_EVERY  # noqa: E402
+from autorig_addon.core.rigging.joint_network import joint_outputs  # noqa: E402
+from autorig_addon.core.rigging.predict import JointVotes, cluster_joints, trained_network  # noqa: E402
+from autorig_addon.core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error  # noqa: E402
+from autorig_addon.core.rigging.training_set import load_example  # noqa: E402
+
+BANDWIDTHS = (0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
+THRESHOLDS = (0.0, 0.01, 0.02, 0.05)
+
+
+def main() -> None:
+    names = sorted(sample.name for sample in training_samples())
+    held = names[::HOLDOUT_EVERY]
+    folder = default_examples_dir(0)
+    weights = trained_network("joints")
+    votes = []
+    for name in held:
+        example = load_example(folder / f"{name.replace('/', '__')}#0.npz")
+        offsets, attention = joint_outputs(weights, example.graph)
+        symmetric = mirror_error(example.graph.vertices, 0) <= SYMMETRY_TOLERANCE
+        votes.append((JointVotes(example.graph.vertices + offsets, attention, None, np.eye(4), symmetric), example))
+    print("| bandwidth | threshold | CD-J2J | IoU | joints predicted / artist's |")
+    print("|---|---|---|---|---|")
+    for bandwidth in BANDWIDTHS:
+        for threshold in THRESHOLDS:
+            scores, ious, counts = [], [], []
+            for vote, example in votes:
+                joints, _ = cluster_joints(vote, bandwidth, threshold, True)
+                scores.append(chamfer_j2j(joints, example.joints))
+                ious.append(joint_iou_precision_recall(joints, example.joints, JOINT_MATCH_FRACTION)["iou"])
+                counts.append(len(joints) / len(example.joints))
+            print(f"| {bandwidth} | {threshold} | {np.mean(scores):.4f} | {np.mean(ious):.3f} | {np.mean(counts):.2f} |")
+
+
+if __name__ == "__main__":
+    main()
