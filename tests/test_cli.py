@@ -19,6 +19,7 @@ from autorig_addon.cli.batch import TextProgress, output_paths
 from autorig_addon.cli.main import SUBCOMMANDS, arguments_from_sys_argv, build_parser, main
 from autorig_addon.core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from autorig_addon.core.geometry.smoothing import MAX_SMOOTHING_ITERATIONS
+from autorig_addon.core.rigging import predict
 from autorig_addon.core.skinning import geometric as skinning
 from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD
 from autorig_addon.core.transfer import options as transfer_options
@@ -90,7 +91,7 @@ def test_help_lists_every_subcommand_without_loading_blender(repository_root):
     )
     assert result.returncode == 0, result.stderr
     text = " ".join(result.stdout.split())
-    assert list(SUBCOMMANDS) == ["transfer", "skin", "eval", "package", "train"]
+    assert list(SUBCOMMANDS) == ["transfer", "skin", "rig", "eval", "package", "train"]
     for name, subcommand in SUBCOMMANDS.items():
         assert f"{name} {subcommand.help}" in text
 
@@ -170,6 +171,9 @@ def test_option_bounds_are_the_panels(clean_scene):
         ("skin", "--falloff", "skin_falloff", skinning.MIN_FALLOFF, skinning.MAX_FALLOFF),
         ("skin", "--max-influences", "skin_max_influences", 0, MAX_INFLUENCES),
         ("skin", "--smoothing-iterations", "skin_smoothing_iterations", 0, MAX_SMOOTHING_ITERATIONS),
+        ("rig", "--bandwidth", "rig_bandwidth", predict.MIN_BANDWIDTH, predict.MAX_BANDWIDTH),
+        ("rig", "--density-threshold", "rig_density_threshold",
+         predict.MIN_DENSITY_THRESHOLD, predict.MAX_DENSITY_THRESHOLD),
     ]
     for subcommand, option, name, low, high in bounds:
         assert (properties[name].hard_min, properties[name].hard_max) == (pytest.approx(low), pytest.approx(high)), name
@@ -204,6 +208,13 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     assert skin.method.upper() == settings.skin_method and skin.method == DEFAULT_SKIN_METHOD
     assert skin.falloff == pytest.approx(settings.skin_falloff) and skin.falloff == skinning.DEFAULT_FALLOFF
     assert skin.smoothing_strength == pytest.approx(settings.skin_smoothing_strength)
+    rig = parse(["rig", "in.blend", *SKIN_ARGUMENTS])
+    assert rig.bandwidth == pytest.approx(settings.rig_bandwidth) and rig.bandwidth == predict.DEFAULT_BANDWIDTH
+    assert rig.density_threshold == pytest.approx(settings.rig_density_threshold)
+    assert rig.density_threshold == predict.DEFAULT_DENSITY_THRESHOLD
+    assert rig.symmetry == settings.rig_symmetry == predict.DEFAULT_SYMMETRY
+    assert rig.skin.upper() == settings.skin_method and parse(["rig", "in.blend", *SKIN_ARGUMENTS, "--no-symmetry"]
+                                                              ).symmetry is False
 
 
 @pytest.mark.parametrize(

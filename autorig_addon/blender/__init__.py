@@ -13,7 +13,8 @@ import bpy
 
 #: Modules with a ``classes`` tuple, in registration order (property groups
 #: before the operators and panels that use them).
-_MODULE_NAMES = ("ui.properties", "operators.transfer", "operators.skin", "operators.rignet", "ui.panels")
+_MODULE_NAMES = ("ui.properties", "operators.transfer", "operators.skin", "operators.rignet", "operators.rig",
+                 "ui.panels")
 
 
 def _modules():

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..core.errors import InputError
-from . import evaluate, package, skin, train, transfer
+from . import evaluate, package, rig, skin, train, transfer
 from .exit_codes import EXIT_FAILED, EXIT_USAGE, UsageError
 
 
@@ -42,7 +42,7 @@ def register_subcommand(name: str, help: str, add_arguments, run) -> None:
     SUBCOMMANDS[name] = Subcommand(help, add_arguments, run)
 
 
-for _module in (transfer, skin, evaluate, package, train):
+for _module in (transfer, skin, rig, evaluate, package, train):
     register_subcommand(_module.NAME, _module.HELP, _module.add_arguments, _module.run)
 
 

@@ -3,6 +3,7 @@
 import bpy
 
 from ...core.skinning.methods import GEOMETRIC
+from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton, live_note, selected_meshes
 from ..operators.skin import AUTORIG_OT_skin_weights
 from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
 
@@ -13,7 +14,7 @@ MAX_LISTED_OBJECTS = 3
 
 
 class VIEW3D_PT_autorig(bpy.types.Panel):
-    """Parent panel; Transfer, Skin and Rig panels open beneath it."""
+    """Parent panel; Rig, Transfer and Skin panels open beneath it."""
 
     bl_label = "AutoRig"
     bl_space_type = "VIEW_3D"
@@ -139,4 +140,32 @@ class VIEW3D_PT_autorig_skin(_AutoRigSubPanel, bpy.types.Panel):
         layout.operator(AUTORIG_OT_skin_weights.bl_idname, icon="MOD_ARMATURE")
 
 
-classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_transfer, VIEW3D_PT_autorig_skin)
+class VIEW3D_PT_autorig_rig(_AutoRigSubPanel, bpy.types.Panel):
+    """Predict a skeleton for the selected meshes, tune it live, skin it, or all in one click."""
+
+    bl_label = "Rig"
+
+    def draw_settings(self, layout, settings, context):
+        meshes = [obj.name for obj in selected_meshes(context)]
+        column = layout.column(align=True)
+        if meshes:
+            column.label(text=f"Character: {_short_list(meshes)}", icon="MESH_DATA")
+        else:
+            column.label(text="Select the character's mesh(es)", icon="INFO")
+
+        column = layout.column(align=True)
+        column.prop(settings, "rig_bandwidth")
+        column.prop(settings, "rig_density_threshold")
+        column.prop(settings, "rig_symmetry")
+        note, icon = live_note(context)
+        if note:
+            layout.label(text=note, icon=icon)
+
+        layout.operator(AUTORIG_OT_predict_skeleton.bl_idname, icon="ARMATURE_DATA")
+        layout.operator(AUTORIG_OT_skin_weights.bl_idname, text="Skin", icon="MOD_ARMATURE")
+        column = layout.column(align=True)
+        column.prop(settings, "rig_replace")
+        column.operator(AUTORIG_OT_auto_rig.bl_idname, icon="OUTLINER_OB_ARMATURE")
+
+
+classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_rig, VIEW3D_PT_autorig_transfer, VIEW3D_PT_autorig_skin)

@@ -6,7 +6,8 @@ same options to scripts and copies the scene's values when run from the UI.
 
 Defaults and bounds come from the core (``core.transfer.options``,
 ``core.transfer.combine``, ``core.skinning.geometric``, ``core.skinning.methods``,
-``core.distances.grid``, ``core.weights``, ``core.geometry.smoothing``),
+``core.distances.grid``, ``core.weights``, ``core.geometry.smoothing``,
+``core.rigging.predict``),
 where the command line takes them too; only the slider ranges (``soft_*``)
 and the absolute distance, which the panel alone offers, are declared here.
 """
@@ -18,6 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 
 from ...core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from ...core.geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
+from ...core.rigging import predict
 from ...core.skinning import geometric as skinning
 from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_DESCRIPTIONS, SKIN_METHOD_LABELS, SKIN_METHODS
 from ...core.transfer import combine
@@ -221,6 +223,47 @@ class SkinOptionProperties:
 SKIN_OPTION_NAMES = tuple(SkinOptionProperties.__annotations__)
 
 
+def _update_live_prediction(self, context) -> None:
+    """A Rig setting of the scene changed: re-cluster the predicted armature
+    while it is unedited (``operators.rig``); an operator's own copy of the
+    option (no scene behind it) changes nothing."""
+    if isinstance(getattr(self, "id_data", None), bpy.types.Scene):
+        from ..operators.rig import on_rig_setting_changed
+
+        on_rig_setting_changed(self, context)
+
+
+class RigOptionProperties:
+    """Skeleton prediction options shared by :class:`AutoRigSceneSettings`
+    and the Predict Skeleton and Auto-Rig operators; on the scene they update
+    the predicted armature live."""
+
+    rig_bandwidth: FloatProperty(
+        name="Bandwidth", description="Level of detail: reach of the clustering of the joint votes, as a share of "
+        "the character's largest side; smaller gives more joints",
+        min=predict.MIN_BANDWIDTH, max=predict.MAX_BANDWIDTH, default=predict.DEFAULT_BANDWIDTH,
+        precision=3, step=0.1, update=_update_live_prediction,
+    )
+    rig_density_threshold: FloatProperty(
+        name="Density Threshold", description="Joints whose vote mass is below this share of the strongest "
+        "are dropped; higher keeps only well-supported joints",
+        subtype="FACTOR", min=predict.MIN_DENSITY_THRESHOLD, max=predict.MAX_DENSITY_THRESHOLD,
+        default=predict.DEFAULT_DENSITY_THRESHOLD, precision=3, step=0.1, update=_update_live_prediction,
+    )
+    rig_symmetry: BoolProperty(
+        name="Symmetry", description="When the character is left-right symmetric, mirror the joint votes and pair "
+        "the joints, so the skeleton is symmetric with .L/.R names",
+        default=predict.DEFAULT_SYMMETRY, update=_update_live_prediction,
+    )
+
+
+#: Names of the rig options, as declared on :class:`RigOptionProperties`.
+RIG_OPTION_NAMES = tuple(RigOptionProperties.__annotations__)
+#: What Auto-Rig's Replace Binding does, for the scene setting and the operator's option.
+REPLACE_BINDING_DESCRIPTION = ("Meshes already bound to an armature lose that binding (its Armature modifier and "
+                               "bone groups) and are bound to the new skeleton; otherwise they are refused")
+
+
 def _is_weighted_mesh(_self, obj) -> bool:
     return obj.type == "MESH" and len(obj.vertex_groups) > 0
 
@@ -229,8 +272,11 @@ def _is_mesh(_self, obj) -> bool:
     return obj.type == "MESH"
 
 
-class AutoRigSceneSettings(TransferOptionProperties, SkinOptionProperties, bpy.types.PropertyGroup):
+class AutoRigSceneSettings(TransferOptionProperties, SkinOptionProperties, RigOptionProperties,
+                           bpy.types.PropertyGroup):
     """Settings of the AutoRig panels, stored per scene."""
+
+    rig_replace: BoolProperty(name="Replace Binding", description=REPLACE_BINDING_DESCRIPTION, default=False)
 
     source: PointerProperty(
         name="Source",

@@ -1,0 +1,121 @@
+"""``python -m autorig_addon rig``: predict a skeleton for the meshes of a
+file and (unless ``--skin none``) bind them to it with skin weights.
+
+Each input holds one character: every mesh of the file except helpers
+(bone shapes, objects hidden from render). A file that already holds an
+armature is refused unless ``--replace``, which removes the armatures, the
+meshes' Armature modifiers and the vertex groups named after their bones
+first. Defaults and bounds are the core's (``core.rigging.predict``,
+``core.skinning.methods``), the ones the Blender panel offers.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..core.errors import InputError
+from ..core.messages import listed_names
+from ..core.rigging import predict
+from ..core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHODS
+from .arguments import bounded
+from .batch import add_batch_arguments, run_batch
+
+NAME = "rig"
+HELP = "Predict a skeleton for a character's meshes and bind them to it (auto-rig)"
+#: The ``--skin`` choice that leaves the meshes unbound.
+NO_SKIN = "none"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    add_batch_arguments(parser)
+    parser.add_argument(
+        "--bandwidth", type=bounded(float, predict.MIN_BANDWIDTH, predict.MAX_BANDWIDTH),
+        default=predict.DEFAULT_BANDWIDTH,
+        help="Level of detail: reach of the clustering of the joint votes as a share of the character's largest "
+             f"side, smaller gives more joints, {predict.MIN_BANDWIDTH:g} to {predict.MAX_BANDWIDTH:g} "
+             f"(default {predict.DEFAULT_BANDWIDTH:g})",
+    )
+    parser.add_argument(
+        "--density-threshold",
+        type=bounded(float, predict.MIN_DENSITY_THRESHOLD, predict.MAX_DENSITY_THRESHOLD),
+        default=predict.DEFAULT_DENSITY_THRESHOLD,
+        help="Joints whose vote mass is below this share of the strongest are dropped, "
+             f"{predict.MIN_DENSITY_THRESHOLD:g} to {predict.MAX_DENSITY_THRESHOLD:g} "
+             f"(default {predict.DEFAULT_DENSITY_THRESHOLD:g})",
+    )
+    parser.add_argument(
+        "--symmetry", action=argparse.BooleanOptionalAction, default=predict.DEFAULT_SYMMETRY,
+        help="Mirror the joints of a left-right symmetric character, with .L/.R names "
+             f"(default {'on' if predict.DEFAULT_SYMMETRY else 'off'})",
+    )
+    parser.add_argument(
+        "--skin", choices=SKIN_METHODS + (NO_SKIN,), default=DEFAULT_SKIN_METHOD,
+        help=f"How the meshes are weighted to the new skeleton ({NO_SKIN}: the armature alone, meshes unbound; "
+             f"default {DEFAULT_SKIN_METHOD}; see the skin subcommand)",
+    )
+    parser.add_argument("--replace", action="store_true",
+                        help="Rig a file that already holds an armature: remove it, the meshes' Armature modifiers "
+                             "and their groups named after its bones first (default: such a file is refused)")
+
+
+def clear_armatures(replace: bool) -> list[str]:
+    """Remove every armature of the loaded file and unbind the meshes from
+    them when ``replace``; otherwise refuse a file that holds one. Returns
+    the names of the removed armatures."""
+    import bpy
+
+    from ..blender.operators.rig import clear_parent_keep_world, remove_armature, unbind
+
+    armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+    if not armatures:
+        return []
+    names = [obj.name for obj in armatures]
+    if not replace:
+        raise InputError(f"The file already holds an armature ({listed_names(names, quoted=True)}): pass --replace "
+                         "to remove it and rig the meshes anew.")
+    for obj in bpy.data.objects:
+        if obj.type == "MESH":
+            unbind(obj)
+    for obj in bpy.data.objects:
+        if obj.parent in armatures:
+            clear_parent_keep_world(obj)
+    for armature in armatures:
+        remove_armature(armature)
+    return names
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..blender.operators.rig import RigSettings, plan_rig, rig_steps, run_steps
+    from ..blender.operators.skin import SkinSettings
+
+    settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry)
+    skin = None if args.skin == NO_SKIN else SkinSettings(method=args.skin)
+
+    def process(input_path, output_path, progress):
+        import bpy
+
+        from ..blender import scene_io
+        from ..blender.object_roles import without_helpers
+
+        scene_io.load_scene(input_path)
+        # Helpers (bone shapes) are told apart while their armature is still there.
+        meshes = without_helpers([obj for obj in bpy.data.objects if obj.type == "MESH"])
+        removed = clear_armatures(args.replace)
+        if not meshes:
+            raise InputError("The file holds no mesh to rig.")
+        plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), Path(input_path).stem, settings,
+                        skin=skin, named=False)
+        result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
+        progress(1.0, "Saving")
+        scene_io.save_scene(output_path)
+        details = {"armature": result.armature.name, "bones": result.skeleton.bone_count,
+                   "meshes": [obj.name for obj in plan.meshes], "skin": args.skin}
+        if removed:
+            details["replaced"] = removed
+        notes = list(result.notes) + (result.skin_plan.notes if result.skin_plan is not None else [])
+        if notes:
+            details["notes"] = notes
+        return details
+
+    return run_batch(args.inputs, args.out, args.format, process, args.summary, args.quiet)

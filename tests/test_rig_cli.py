@@ -1,0 +1,131 @@
+"""``python -m autorig_addon rig`` on a procedural biped written by the test (.glb and .blend)."""
+
+import json
+
+import bpy
+import numpy as np
+import pytest
+
+from autorig_addon.blender import scene_io
+from autorig_addon.blender.convert import read_weights
+from autorig_addon.cli.main import main
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict
+from blender_fixtures import make_armature, mesh_object, reset_scene
+
+#: A symmetric procedural biped (1,866 vertices).
+BIPED_SEED = 0
+RIG_ARGUMENTS = ["--out", "o.blend"]
+
+
+def run_main(arguments, capsys):
+    """``main(arguments)``: (exit code, stdout, stderr)."""
+    capsys.readouterr()
+    code = main(arguments)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def save_biped(path, bound_to_armature=False):
+    """The biped (object 'Biped') alone, or bound to a two-bone armature 'Old' with its groups."""
+    reset_scene()
+    character = generate_character(BIPED_SEED, "biped")
+    obj = mesh_object("Biped", character.mesh.vertices, character.mesh.triangles)
+    if bound_to_armature:
+        old = make_armature("Old")
+        modifier = obj.modifiers.new("Armature", "ARMATURE")
+        modifier.object = old
+        obj.parent = old
+        group = obj.vertex_groups.new(name="Lower")
+        group.add(list(range(len(obj.data.vertices))), 1.0, "REPLACE")
+    bpy.context.view_layer.update()
+    scene_io.save_scene(path)
+
+
+def objects_of(path):
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    return {obj.name: obj for obj in bpy.data.objects}
+
+
+def the_armature_and_mesh(path):
+    objects = objects_of(path)
+    armatures = [obj for obj in objects.values() if obj.type == "ARMATURE"]
+    meshes = [obj for obj in objects.values() if obj.type == "MESH"]
+    assert len(armatures) == 1 and len(meshes) == 1
+    return armatures[0], meshes[0]
+
+
+def test_rig_a_glb_binds_the_mesh(clean_scene, tmp_path, capsys):
+    source, out = tmp_path / "hero.glb", tmp_path / "out" / "hero.blend"
+    save_biped(source)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--quiet"], capsys)
+
+    assert code == 0
+    summary = json.loads(stdout)
+    (item,) = summary["succeeded"]
+    assert summary["failed"] == []
+    armature, mesh = the_armature_and_mesh(out)
+    bones = [bone.name for bone in armature.data.bones]
+    assert (item["armature"], item["bones"], item["skin"]) == ("hero_rig", len(bones), "heterskinnet")
+    assert armature.name == "hero_rig" and len(bones) >= 5 and all(b.use_deform for b in armature.data.bones)
+    assert {group.name for group in mesh.vertex_groups} <= set(bones) and len(mesh.vertex_groups) >= 2
+    np.testing.assert_allclose(read_weights(mesh, bones).matrix.sum(axis=1), 1.0, atol=1e-5)
+    assert [(m.type, m.object) for m in mesh.modifiers] == [("ARMATURE", armature)]
+
+
+def test_skin_none_leaves_the_mesh_unbound(clean_scene, tmp_path, capsys):
+    source, out = tmp_path / "hero.blend", tmp_path / "rigged.blend"
+    save_biped(source)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "none", "--no-symmetry",
+                                "--bandwidth", str(2 * predict.DEFAULT_BANDWIDTH), "--quiet"], capsys)
+
+    assert code == 0 and json.loads(stdout)["succeeded"][0]["skin"] == "none"
+    armature, mesh = the_armature_and_mesh(out)
+    assert len(armature.data.bones) >= 2
+    assert len(mesh.vertex_groups) == 0 and len(mesh.modifiers) == 0 and mesh.parent is None
+
+
+def test_existing_armature_is_refused_unless_replace(clean_scene, tmp_path, capsys):
+    source, out = tmp_path / "bound.blend", tmp_path / "out"
+    save_biped(source, bound_to_armature=True)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--quiet"], capsys)
+
+    assert code == 1
+    summary = json.loads(stdout)
+    assert summary["succeeded"] == [] and summary["failed"] == [{
+        "input": str(source),
+        "error": "The file already holds an armature ('Old'): pass --replace to remove it and rig the meshes anew.",
+    }]
+    assert not out.exists()
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--replace", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert item["replaced"] == ["Old"]
+    armature, mesh = the_armature_and_mesh(out / "bound.blend")
+    assert armature.name == "bound_rig" and mesh.parent == armature
+    assert "Lower" not in mesh.vertex_groups.keys()
+    assert [(m.type, m.object) for m in mesh.modifiers] == [("ARMATURE", armature)]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["rig", "in.blend"], "error: the following arguments are required: --out"),
+        (["rig", "in.blend", *RIG_ARGUMENTS, "--bandwidth", str(2 * predict.MAX_BANDWIDTH)],
+         f"error: argument --bandwidth: {2 * predict.MAX_BANDWIDTH} is not between "
+         f"{predict.MIN_BANDWIDTH:g} and {predict.MAX_BANDWIDTH:g}"),
+        (["rig", "in.blend", *RIG_ARGUMENTS, "--density-threshold", "-0.5"],
+         f"error: argument --density-threshold: -0.5 is not between {predict.MIN_DENSITY_THRESHOLD:g} and "
+         f"{predict.MAX_DENSITY_THRESHOLD:g}"),
+        (["rig", "in.blend", *RIG_ARGUMENTS, "--skin", "magic"], "error: argument --skin: invalid choice: 'magic'"),
+    ],
+)
+def test_bad_arguments_exit_2_with_the_reason(arguments, message, capsys):
+    code, out, err = run_main(arguments, capsys)
+    assert code == 2 and out == ""
+    assert message in err

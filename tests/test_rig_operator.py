@@ -1,0 +1,283 @@
+"""Predict Skeleton and Auto-Rig (autorig_addon.blender.operators.rig) on a
+procedural biped, with real bpy."""
+
+import re
+import time
+from types import SimpleNamespace
+
+import bpy
+import numpy as np
+import pytest
+
+from autorig_addon.blender import convert
+from autorig_addon.blender.operators import rig
+from autorig_addon.blender.operators.rig import PREDICTED_PROPERTY, RigSettings, plan_rig, rig_steps, run_steps
+from autorig_addon.blender.operators.skin import SkinSettings
+from autorig_addon.core.errors import Cancelled
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict
+from blender_fixtures import (
+    RecordingWindowManager,
+    RecordingWorkspace,
+    group_weights,
+    make_armature,
+    mesh_object,
+    scene_state,
+    select_only,
+)
+
+#: A symmetric procedural biped (1,866 vertices, 29 bones in its own rig, 1.0 tall).
+BIPED_SEED = 0
+#: A bone tail may stick out of the mesh's bounding box by this share of its
+#: diagonal (a leaf's tail is extrapolated from its chain); heads may not.
+BOX_SLACK = 0.05
+#: Two levels of detail around the default (a smaller bandwidth gives more joints).
+FINE_BANDWIDTH, COARSE_BANDWIDTH = 0.75 * predict.DEFAULT_BANDWIDTH, 4 * predict.DEFAULT_BANDWIDTH
+
+
+def armatures():
+    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+
+
+def add_biped(name="Biped"):
+    character = generate_character(BIPED_SEED, "biped")
+    obj = mesh_object(name, character.mesh.vertices, character.mesh.triangles)
+    bpy.context.view_layer.update()
+    return obj
+
+
+@pytest.fixture
+def biped(clean_scene):
+    obj = add_biped()
+    select_only([obj], active=obj)
+    return obj
+
+
+def outside_box(points, vertices) -> np.ndarray:
+    """(k,) how far each point lies outside the vertices' bounding box, share of its diagonal (0 inside)."""
+    low, high = vertices.min(0), vertices.max(0)
+    return np.linalg.norm(np.maximum(low - points, 0) + np.maximum(points - high, 0), axis=1) / np.linalg.norm(high - low)
+
+
+def bone_count_at(bandwidth: float) -> int:
+    bpy.context.scene.autorig.rig_bandwidth = bandwidth
+    (armature,) = armatures()
+    return len(armature.data.bones)
+
+
+def test_predict_skeleton_builds_one_armature_inside_the_mesh(biped):
+    mesh_before = scene_state([biped])
+    mesh_before.pop("objects")
+
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+
+    (armature,) = armatures()
+    names = [bone.name for bone in armature.data.bones]
+    assert armature.name == "Biped_rig" and len(names) >= 5 and len(set(names)) == len(names)
+    assert all(bone.use_deform for bone in armature.data.bones)
+    assert armature[PREDICTED_PROPERTY] in rig._PREDICTIONS
+    assert outside_box(convert.read_skeleton(armature).joints, convert.read_mesh([biped]).vertices).max() == 0.0
+    # The armature is active beside the still selected mesh, ready for Skin.
+    assert bpy.context.view_layer.objects.active == armature and biped.select_get()
+    state = scene_state([biped])
+    state.pop("objects")
+    assert state == mesh_before
+
+
+def test_predicted_bone_tails_stay_near_the_mesh(biped):
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (armature,) = armatures()
+    assert outside_box(convert.read_skeleton(armature).tails, convert.read_mesh([biped]).vertices).max() <= BOX_SLACK
+
+
+def test_predict_skeleton_is_one_undo_step(biped):
+    bpy.ops.ed.undo_push(message="before")
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    # Background runs push no undo step of their own; Blender pushes this one after the operator.
+    bpy.ops.ed.undo_push(message="Predict Skeleton")
+    assert len(armatures()) == 1
+    bpy.ops.ed.undo()
+    assert armatures() == [] and sorted(bpy.data.objects.keys()) == ["Biped"]
+    assert len(bpy.data.armatures) == 0
+
+
+def test_bandwidth_reclusters_the_same_armature_live(biped):
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (armature,) = armatures()
+    pointer = armature.as_pointer()
+
+    fine = bone_count_at(FINE_BANDWIDTH)
+    coarse = bone_count_at(COARSE_BANDWIDTH)
+
+    assert coarse <= fine and fine > 1
+    assert armatures()[0].as_pointer() == pointer and len(bpy.data.armatures) == 1
+    # The rebuilt bones are the core's skeleton at that bandwidth.
+    votes = rig._prediction_of(armature).votes
+    expected = predict.skeleton_from_votes(votes, bandwidth=COARSE_BANDWIDTH)
+    built = convert.read_skeleton(armature)
+    # Blender lists sibling bones in its own order: compare bone by bone.
+    assert sorted(built.names) == sorted(expected.names)
+    order = [built.names.index(name) for name in expected.names]
+    np.testing.assert_allclose(built.joints[order], expected.joints, atol=1e-5)
+    assert rig.live_note(bpy.context) == ("Live: the settings update 'Biped_rig'", "ARMATURE_DATA")
+
+
+def test_edited_armature_is_left_alone(biped):
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (armature,) = armatures()
+    bpy.ops.object.mode_set(mode="EDIT")
+    bone = armature.data.edit_bones[0]
+    bone.tail = bone.tail + (bone.tail - bone.head) * 0.5
+    bpy.ops.object.mode_set(mode="OBJECT")
+    edited = convert.read_skeleton(armature)
+
+    bpy.context.scene.autorig.rig_bandwidth = predict.MAX_BANDWIDTH
+
+    after = convert.read_skeleton(armature)
+    assert after.names == edited.names
+    np.testing.assert_array_equal(after.tails, edited.tails)
+    assert rig.live_note(bpy.context) == (
+        "'Biped_rig' was edited: the settings apply at the next Predict Skeleton", "INFO")
+
+
+def test_auto_rig_binds_every_vertex(biped):
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    bones = [bone.name for bone in armature.data.bones]
+    # A bone no vertex follows gets no group (the skin writer's rule); no other group is made.
+    assert {group.name for group in biped.vertex_groups} <= set(bones) and len(biped.vertex_groups) >= 2
+    np.testing.assert_allclose(group_weights(biped, bones).sum(axis=1), 1.0, atol=1e-5)
+    assert [(m.type, m.object) for m in biped.modifiers] == [("ARMATURE", armature)]
+    assert biped.parent == armature
+    # Bound, the armature no longer follows the settings.
+    assert rig.live_note(bpy.context)[0] == "'Biped_rig' is bound to meshes: the settings apply at the next Predict Skeleton"
+
+
+def test_nothing_selected_is_refused_and_scene_unchanged(biped):
+    select_only([], active=None)
+    before = scene_state([biped])
+    for operator in (bpy.ops.autorig.predict_skeleton, bpy.ops.autorig.auto_rig):
+        with pytest.raises(RuntimeError, match=re.escape("Select the mesh(es) of the character to rig.")):
+            operator()
+    assert scene_state([biped]) == before and len(bpy.data.armatures) == 0
+
+
+def test_mesh_without_faces_is_refused_and_scene_unchanged(clean_scene):
+    points = mesh_object("Points", [[0, 0, 0.5], [0, 0, 1.5], [0.1, 0, 1.0]], [])
+    bpy.context.view_layer.update()
+    select_only([points], active=points)
+    before = scene_state([points])
+    with pytest.raises(RuntimeError, match=re.escape(
+            "'Points' has no faces: it is only vertices or edges. "
+            "Add faces to it (Edit Mode > Face > Fill) or pick a mesh with a surface.")):
+        bpy.ops.autorig.predict_skeleton()
+    assert scene_state([points]) == before and len(bpy.data.armatures) == 0
+
+
+def test_auto_rig_refuses_a_bound_mesh_unless_replace(biped):
+    old = make_armature("Old")
+    modifier = biped.modifiers.new("Armature", "ARMATURE")
+    modifier.object = old
+    biped.vertex_groups.new(name="Lower")
+    biped.vertex_groups.new(name="Mask")
+    select_only([biped], active=biped)
+    before = scene_state([biped, old])
+
+    with pytest.raises(RuntimeError, match=re.escape(
+            "'Biped' is already bound to the armature 'Old': turn on Replace Binding to bind it to the new skeleton "
+            "instead, or remove its Armature modifier first.")):
+        bpy.ops.autorig.auto_rig()
+    assert scene_state([biped, old]) == before
+
+    assert bpy.ops.autorig.auto_rig(rig_replace=True) == {"FINISHED"}
+    new = bpy.data.objects["Biped_rig"]
+    assert [(m.type, m.object) for m in biped.modifiers] == [("ARMATURE", new)]
+    groups = {group.name for group in biped.vertex_groups}
+    assert "Lower" not in groups and "Mask" in groups  # the old bones' groups go, the artist's stay
+    assert bpy.data.objects.get("Old") is not None  # the old armature itself stays in the scene
+
+
+def test_cancel_while_skinning_leaves_nothing(biped):
+    """Esc during the skin weights (the second task) removes the armature built before them."""
+    before = scene_state([biped])
+    plan = plan_rig([biped], bpy.context.evaluated_depsgraph_get(), "Biped", RigSettings(), skin=SkinSettings())
+
+    def progress(fraction, message):
+        if fraction > rig.PREDICTION_SHARE:
+            raise Cancelled("Rigging cancelled.")
+
+    with pytest.raises(Cancelled):
+        run_steps(rig_steps(bpy.context, plan), progress)
+    assert scene_state([biped]) == before and len(bpy.data.armatures) == 0
+
+
+# --------------------------------------------------------------------------- the modal run (worker thread, Esc)
+
+
+class RigOperatorStandIn:
+    """The modal machinery of the rig operators without Blender's operator
+    object: reports recorded, a timer already added."""
+
+    modal = rig._RigOperator.modal
+    cancel = rig._RigOperator.cancel
+    _advance = rig._RigOperator._advance
+    _end_modal = rig._RigOperator._end_modal
+    _fail = rig._RigOperator._fail
+    _finish = rig._RigOperator._finish
+
+    def __init__(self, steps):
+        self._steps, self._job, self._timer = steps, None, "timer"
+        self.reports = []
+
+    def report(self, kind, message):
+        self.reports.append((kind, message))
+
+
+def ui_context():
+    return SimpleNamespace(window_manager=RecordingWindowManager(), workspace=RecordingWorkspace(),
+                           view_layer=bpy.context.view_layer)
+
+
+def tick_until_done(operator, context, limit_seconds=120.0):
+    started = time.perf_counter()
+    while time.perf_counter() - started < limit_seconds:
+        outcome = operator.modal(context, SimpleNamespace(type="TIMER"))
+        if outcome != {"RUNNING_MODAL"}:
+            return outcome
+        time.sleep(0.01)
+    raise AssertionError("the modal run did not end")
+
+
+def test_modal_run_predicts_in_a_worker_and_ends_cleanly(biped):
+    plan = plan_rig([biped], bpy.context.evaluated_depsgraph_get(), "Biped")
+    operator, context = RigOperatorStandIn(rig_steps(bpy.context, plan)), ui_context()
+    assert operator._advance(context, None, None) is None  # the prediction runs in a worker thread
+
+    assert tick_until_done(operator, context) == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert operator.reports[0][1].startswith(f"Predicted 'Biped_rig' with {len(armature.data.bones)} bones")
+    assert context.window_manager.calls[-2:] == [("remove_timer", "timer"), ("end",)]
+    assert context.workspace.texts[-1] is None and context.workspace.texts[0].startswith("Auto-Rig: ")
+
+
+def test_esc_stops_the_worker_and_leaves_nothing(biped, monkeypatch):
+    def endless_votes(mesh, progress):
+        for _ in range(10000):  # until cancelled (at most about 10 s)
+            progress(0.5, "Voting")
+            time.sleep(0.001)
+        raise AssertionError("never cancelled")
+
+    monkeypatch.setattr(rig, "predict_votes", endless_votes)
+    before = scene_state([biped])
+    plan = plan_rig([biped], bpy.context.evaluated_depsgraph_get(), "Biped", skin=SkinSettings())
+    operator, context = RigOperatorStandIn(rig_steps(bpy.context, plan)), ui_context()
+    operator._advance(context, None, None)
+
+    assert operator.modal(context, SimpleNamespace(type="ESC")) == {"RUNNING_MODAL"}
+    assert tick_until_done(operator, context) == {"CANCELLED"}
+
+    assert operator.reports == [({"WARNING"}, "Rigging cancelled; nothing was changed.")]
+    assert scene_state([biped]) == before and len(bpy.data.armatures) == 0
+    assert context.window_manager.calls[-2:] == [("remove_timer", "timer"), ("end",)]
