@@ -27,6 +27,7 @@ import bpy  # noqa: E402
 import mathutils  # noqa: E402
 
 from autorig_addon.core.procedural import KINDS, generate_character  # noqa: E402
+from docs_render import bone_sticks  # noqa: E402
 
 #: Image size in pixels (width per character, height).
 CELL_PIXELS = 200
@@ -70,29 +71,6 @@ def mesh_object(name, vertices, triangles, colours=None):
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
-
-
-def bone_sticks(joints, tails, radius):
-    """Vertices and triangles of a thin octahedron along each bone."""
-    vertices, triangles = [], []
-    for head, tail in zip(joints, tails):
-        axis = tail - head
-        length = np.linalg.norm(axis)
-        if length < 1e-9:
-            continue
-        axis /= length
-        other = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        side = np.cross(axis, other)
-        side /= np.linalg.norm(side)
-        up = np.cross(axis, side)
-        ring = head + 0.15 * length * axis + radius * np.array([side, up, -side, -up])
-        base = sum(len(v) for v in vertices)
-        vertices.append(np.vstack([head, ring, tail]))
-        for k in range(4):
-            a, b = 1 + k, 1 + (k + 1) % 4
-            triangles.append([base, base + b, base + a])
-            triangles.append([base + a, base + b, base + 5])
-    return np.vstack(vertices), np.array(triangles)
 
 
 def render_row(kind, seeds, path, cell_pixels=CELL_PIXELS):

@@ -3,9 +3,9 @@
 The window manager's progress (the cursor counter / status bar) and the
 workspace status text are updated; both are optional in background mode,
 where there may be no window or workspace. :func:`blender_progress` shows
-a job that runs on the main thread; the modal Skin operator, whose job runs
-in a worker thread, shows it with :func:`progress_step` and
-:func:`progress_text` on each timer tick.
+a job that runs on the main thread; the modal operators, whose jobs run in
+a worker thread, show it with :func:`progress_step` and
+:func:`progress_text` on each timer tick (:mod:`.operators.modal_job`).
 """
 
 from __future__ import annotations

@@ -22,10 +22,9 @@ edits it, the settings wait for the next *Predict Skeleton*.
 
 from __future__ import annotations
 
-import threading
 import uuid
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Generator
 
 import bpy
@@ -41,13 +40,14 @@ from ...core.skinning.methods import SKIN_METHOD_LABELS
 from ...core.types import Mesh, Skeleton
 from .. import convert
 from ..armature_builder import build_armature
-from ..progress import PROGRESS_STEPS, blender_progress, progress_step, progress_text
+from ..progress import blender_progress
 from ..snapshot import restored_on_failure
 from ..ui.properties import (
     REPLACE_BINDING_DESCRIPTION, RIG_OPTION_NAMES, SKIN_OPTION_NAMES, RigOptionProperties, SkinOptionProperties,
 )
 from .input_checks import check_mode, mode_poll
-from .skin import SkinSettings, _settings_from, compute_skin, plan_skin, write_skin
+from .modal_job import ModalJobOperator, WorkerJob, show_job_event
+from .skin import SkinSettings, compute_skin, plan_skin, skin_settings_from, write_skin
 
 #: Custom property marking an armature built by a prediction; its value is
 #: the key of the prediction's cached network outputs.
@@ -62,8 +62,6 @@ PREDICTION_SHARE = 0.4
 #: Rest bone positions differing by more than this share of the skeleton's
 #: extent mean the armature was edited (Blender stores bones in float32).
 EDIT_TOLERANCE = 1e-5
-#: Seconds between progress refreshes of the running modal operators.
-MODAL_TIMER_SECONDS = 0.1
 #: Prefix of the status-bar text while a prediction runs.
 RIG_PROGRESS_TITLE = "Auto-Rig"
 
@@ -409,41 +407,18 @@ def rig_settings_from(props) -> RigSettings:
 
 
 @dataclass
-class _TaskJob:
-    """One task of the steps, run by a worker thread for a modal operator.
-
-    The worker writes progress and the outcome here; the operator reads
-    them on each timer tick and sets ``cancel`` to stop it (the next
-    progress report raises :class:`Cancelled`). The job never touches
-    ``bpy`` or the operator.
-    """
+class _TaskJob(WorkerJob):
+    """One task of the steps, run by a worker thread for a modal operator;
+    its outcome is handed to the steps on the main thread."""
 
     task: Task
-    fraction: float = 0.0
-    message: str = "Starting"
-    result: object = None
-    error: BaseException | None = None
-    cancel: bool = False
-    thread: threading.Thread = field(default=None, repr=False)
+    cancelled_message = "Rigging cancelled."
 
-    def progress(self, fraction: float, message: str) -> None:
-        if self.cancel:
-            raise Cancelled("Rigging cancelled.")
-        self.fraction, self.message = fraction, message
-
-    def run(self) -> None:
-        try:
-            self.result = self.task(self.progress)
-        except BaseException as error:  # handed to the steps on the main thread
-            self.error = error
-
-    def start(self) -> "_TaskJob":
-        self.thread = threading.Thread(target=self.run, daemon=True)
-        self.thread.start()
-        return self
+    def compute(self, progress: ProgressCallback):
+        return self.task(progress)
 
 
-class _RigOperator(RigOptionProperties):
+class _RigOperator(ModalJobOperator, RigOptionProperties):
     """Shared by Predict Skeleton and Auto-Rig: the plan, the modal run of
     :func:`rig_steps` and the report. A subclass sets ``binds`` and its
     ``skin_settings``."""
@@ -452,8 +427,6 @@ class _RigOperator(RigOptionProperties):
     binds = False
 
     _steps = None
-    _job = None
-    _timer = None
 
     @classmethod
     def poll(cls, context):
@@ -487,10 +460,7 @@ class _RigOperator(RigOptionProperties):
         outcome = self._advance(context, None, None)
         if outcome is not None:
             return outcome
-        window_manager = context.window_manager
-        self._timer = window_manager.event_timer_add(MODAL_TIMER_SECONDS, window=context.window)
-        window_manager.progress_begin(0, PROGRESS_STEPS)
-        window_manager.modal_handler_add(self)
+        self._begin_modal(context)
         return {"RUNNING_MODAL"}
 
     def _advance(self, context, result, error):
@@ -513,15 +483,7 @@ class _RigOperator(RigOptionProperties):
 
     def modal(self, context, event):
         job = self._job
-        if event.type == "ESC":
-            job.cancel = True
-        if event.type != "TIMER":
-            return {"RUNNING_MODAL"}
-        context.window_manager.progress_update(progress_step(job.fraction))
-        if context.workspace is not None:
-            text = progress_text(RIG_PROGRESS_TITLE, job.fraction, job.message)
-            context.workspace.status_text_set(f"{text}, Esc to cancel")
-        if job.thread.is_alive():
+        if not show_job_event(context, event, job, RIG_PROGRESS_TITLE) or job.thread.is_alive():
             return {"RUNNING_MODAL"}
         return self._advance(context, job.result, job.error) or {"RUNNING_MODAL"}
 
@@ -534,15 +496,6 @@ class _RigOperator(RigOptionProperties):
         if self._steps is not None:
             self._steps.close()
         self._end_modal(context)
-
-    def _end_modal(self, context) -> None:
-        if self._timer is None:
-            return
-        context.window_manager.event_timer_remove(self._timer)
-        self._timer = None
-        context.window_manager.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
 
     def _fail(self, error):
         if isinstance(error, Cancelled):
@@ -593,7 +546,7 @@ class AUTORIG_OT_auto_rig(_RigOperator, SkinOptionProperties, bpy.types.Operator
         return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace",)
 
     def skin_settings(self) -> SkinSettings:
-        return _settings_from(self)
+        return skin_settings_from(self)
 
 
 classes = (AUTORIG_OT_predict_skeleton, AUTORIG_OT_auto_rig)

@@ -19,7 +19,6 @@ the command line) it runs synchronously.
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass, field
 
 import bpy
@@ -37,19 +36,18 @@ from ...core.distances.grid import DEFAULT_RESOLUTION
 from ...core.geometry.outliers import require_finite_positions, rows_for_strays
 from .. import convert
 from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
-from ..progress import PROGRESS_STEPS, blender_progress, progress_step, progress_text
+from ..progress import blender_progress
 from ..scene_io import find_object
 from ..snapshot import restored_on_failure
 from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
 from ..weight_writer import bind_to_bone, write_weights
 from .input_checks import check_mode, mode_poll, split_strays, stray_notes
+from .modal_job import ModalJobOperator, WorkerJob, show_job_event
 
 #: When even the deform bone point nearest the mesh's bounding box is
 #: farther than this many mesh diagonals from it, the armature was not
 #: placed on the character.
 MAX_ARMATURE_OFFSET = 0.5
-#: Seconds between progress refreshes of the running modal operator.
-MODAL_TIMER_SECONDS = 0.1
 #: Prefix of the status-bar text while skinning runs.
 SKIN_PROGRESS_TITLE = "Skin weights"
 
@@ -252,7 +250,7 @@ def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
     return armature, meshes
 
 
-def _settings_from(props) -> SkinSettings:
+def skin_settings_from(props) -> SkinSettings:
     """SkinSettings from the ``skin_*`` properties of the operator or scene settings."""
     values = {name[len("skin_"):]: getattr(props, name) for name in SKIN_OPTION_NAMES}
     values["distance"] = values["distance"].lower()
@@ -261,39 +259,23 @@ def _settings_from(props) -> SkinSettings:
 
 
 @dataclass
-class _SkinJob:
-    """A skinning computation run by a worker thread for the modal operator.
-
-    The worker (:meth:`run`) writes progress and the outcome here, the
-    operator reads them on each timer tick and sets ``cancel`` to stop it.
-    The job never touches the operator or ``bpy``, so Blender may free the
-    operator (:meth:`AUTORIG_OT_skin_weights.cancel`) while it runs.
-    """
+class _SkinJob(WorkerJob):
+    """A skinning computation (:func:`compute_skin` of ``plan``) run by a
+    worker thread for the modal operator; the weights are ``weights``."""
 
     plan: SkinPlan
-    fraction: float = 0.0
-    message: str = "Starting"
-    weights: Weights | None = None
-    error: BaseException | None = None
-    cancel: bool = False
+    cancelled_message = "Skinning cancelled."
 
-    def run(self) -> None:
-        """Compute the weights into ``weights``, or the exception into
-        ``error``; once ``cancel`` is set, the next progress report raises
-        :class:`Cancelled`."""
+    def compute(self, progress: ProgressCallback) -> Weights:
+        return compute_skin(self.plan, progress)
 
-        def progress(fraction: float, message: str) -> None:
-            if self.cancel:
-                raise Cancelled("Skinning cancelled.")
-            self.fraction, self.message = fraction, message
-
-        try:
-            self.weights = compute_skin(self.plan, progress)
-        except BaseException as error:  # reported from the main thread
-            self.error = error
+    @property
+    def weights(self) -> Weights | None:
+        """The computed weights (None until the worker finishes, or when it failed)."""
+        return self.result
 
 
-class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
+class AUTORIG_OT_skin_weights(ModalJobOperator, SkinOptionProperties, bpy.types.Operator):
     """Weight the selected meshes to the selected armature, by the geometric method or a trained network; Esc cancels"""
 
     bl_idname = "autorig.skin_weights"
@@ -303,9 +285,7 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
     armature: StringProperty(name="Armature", description="Armature to bind to (empty: the selected one)")
     meshes: StringProperty(name="Meshes", description="Comma-separated meshes to skin (empty: the selected ones)")
 
-    _job = None
     _thread = None
-    _timer = None
 
     @classmethod
     def poll(cls, context):
@@ -320,30 +300,18 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
             return self.execute(context)
         try:
             armature, meshes = resolve_skin_inputs(context, self.armature, self.meshes)
-            plan = plan_skin(armature, meshes, _settings_from(self), context.evaluated_depsgraph_get())
+            plan = plan_skin(armature, meshes, skin_settings_from(self), context.evaluated_depsgraph_get())
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self._job = _SkinJob(plan)
-        self._thread = threading.Thread(target=self._job.run, daemon=True)
-        self._thread.start()
-        window_manager = context.window_manager
-        self._timer = window_manager.event_timer_add(MODAL_TIMER_SECONDS, window=context.window)
-        window_manager.progress_begin(0, PROGRESS_STEPS)
-        window_manager.modal_handler_add(self)
+        self._job = _SkinJob(plan).start()
+        self._thread = self._job.thread
+        self._begin_modal(context)
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
         job = self._job
-        if event.type == "ESC":
-            job.cancel = True
-        if event.type != "TIMER":
-            return {"RUNNING_MODAL"}
-        context.window_manager.progress_update(progress_step(job.fraction))
-        if context.workspace is not None:
-            text = progress_text(SKIN_PROGRESS_TITLE, job.fraction, job.message)
-            context.workspace.status_text_set(f"{text}, Esc to cancel")
-        if self._thread.is_alive():
+        if not show_job_event(context, event, job, SKIN_PROGRESS_TITLE) or self._thread.is_alive():
             return {"RUNNING_MODAL"}
         self._end_modal(context)
         if isinstance(job.error, Cancelled):
@@ -363,18 +331,6 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
             self._job.cancel = True
         self._end_modal(context)
 
-    def _end_modal(self, context) -> None:
-        """Remove the timer, end the progress display and clear the status
-        text; the finished run (``modal``) and :meth:`cancel` both end here,
-        and a second call does nothing."""
-        if self._timer is None:
-            return
-        context.window_manager.event_timer_remove(self._timer)
-        self._timer = None
-        context.window_manager.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
-
     def _write(self, plan: SkinPlan, weights: Weights):
         try:
             write_skin(plan, weights)
@@ -388,7 +344,7 @@ class AUTORIG_OT_skin_weights(SkinOptionProperties, bpy.types.Operator):
     def execute(self, context):
         try:
             armature, meshes = resolve_skin_inputs(context, self.armature, self.meshes)
-            plan = plan_skin(armature, meshes, _settings_from(self), context.evaluated_depsgraph_get())
+            plan = plan_skin(armature, meshes, skin_settings_from(self), context.evaluated_depsgraph_get())
             with blender_progress(context, SKIN_PROGRESS_TITLE) as progress:
                 weights = compute_skin(plan, progress)
         except (InputError, Cancelled) as error:

@@ -16,6 +16,10 @@ The MLP's first layer is linear, so with its weight split as ``[A, B]``
 gathered per edge, instead of building the (e, 2c) message rows, which
 saves most of the layer's time (a mesh has ~10-40 times more edges than
 vertices).
+
+RigNet's GMEdgeConv block (:func:`gmedge_block`) runs two EdgeConvs, over
+the mesh one-ring and over geodesic balls, and fuses them with a residual;
+the skinning and the joint networks both stack it.
 """
 
 from __future__ import annotations
@@ -73,6 +77,31 @@ def edge_convolution(x: np.ndarray, edges: np.ndarray, weights: dict, prefix: st
     messages = mlp(hidden, weights, prefix + "mlp.", activation=activation, norm=norm, activate_last=activate_last,
                    first_linear_applied=True)
     return AGGREGATIONS[aggregation](messages, edges[1], len(x))
+
+
+def gmedge_block(x: np.ndarray, mesh_edges: np.ndarray, ball_edges: np.ndarray, weights: dict, prefix: str, *,
+                 activation: str = "relu") -> np.ndarray:
+    """RigNet's GMEdgeConv block, residual included: ``x + fuse([one_ring, ball])``.
+
+    Parameters
+    ----------
+    x : (n, c) float array, node features
+    mesh_edges : (2, e) int array, the mesh one-ring (:func:`.graph.mesh_edges`)
+    ball_edges : (2, b) int array, the geodesic balls (:func:`.graph.geodesic_ball_edges`)
+    weights : dict of str -> array, holding the EdgeConvs ``prefix + "one_ring."``
+        and ``prefix + "ball."`` (max-aggregated, ``c`` outputs each) and the MLP
+        ``prefix + "fuse."`` (``2c`` inputs, ``c`` outputs): the ``state_dict`` of
+        :class:`autorig_addon.core.nn.training.convolution.GMEdgeBlock` under ``prefix``
+    prefix : str, the block's name with its trailing dot (``"gmedge1."``)
+    activation : str, every layer's activation (:func:`.layers.mlp`)
+
+    Returns
+    -------
+    (n, c) float array, the block's new node features.
+    """
+    one_ring = edge_convolution(x, mesh_edges, weights, prefix + "one_ring.", activation=activation)
+    ball = edge_convolution(x, ball_edges, weights, prefix + "ball.", activation=activation)
+    return x + mlp(np.concatenate([one_ring, ball], axis=1), weights, prefix + "fuse.", activation=activation)
 
 
 def multi_aggregator_convolution(x: np.ndarray, edges: np.ndarray, weights: dict, prefix: str, *,

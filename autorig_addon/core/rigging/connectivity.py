@@ -132,12 +132,23 @@ def root_scores(weights: dict, features: np.ndarray) -> np.ndarray:
 
 def spanning_tree(joint_count: int, pairs: np.ndarray, probabilities: np.ndarray, mirror: np.ndarray,
                   joints: np.ndarray) -> np.ndarray:
-    """(joint_count - 1, 2) edges of the tree (see the module docstring)."""
+    """(joint_count - 1, 2) edges of the tree (see the module docstring).
+
+    Kruskal's algorithm over ``-log p`` in two passes. The first takes an
+    edge only together with its mirror twin, and only when both keep the
+    tree a forest, and never joins a joint to its own twin while the
+    midline offers a path (left and right then hang from the midline, never
+    from each other). The second joins whatever the first left apart,
+    cheapest edge first, one edge at a time.
+    """
     cost = {tuple(pair): -np.log(max(float(p), PROBABILITY_FLOOR)) for pair, p in zip(pairs.tolist(), probabilities)}
     everything = np.array([(a, b) for a in range(joint_count) for b in range(a + 1, joint_count)], dtype=np.int64)
     lengths = np.linalg.norm(joints[everything[:, 0]] - joints[everything[:, 1]], axis=1) if len(everything) else []
     costs = np.array([cost.get((a, b), UNSCORED_PAIR_COST + length) for (a, b), length in zip(everything.tolist(), lengths)])
-    twin = np.where(np.asarray(mirror) >= 0, mirror, np.arange(joint_count))
+    order = everything[np.argsort(costs, kind="stable")].tolist()
+    mirror = np.asarray(mirror)
+    twin = np.where(mirror >= 0, mirror, np.arange(joint_count))
+    has_midline = bool(np.any(mirror < 0)) and bool(np.any(mirror >= 0))
     parent = np.arange(joint_count)
 
     def find(node: int) -> int:
@@ -147,15 +158,27 @@ def spanning_tree(joint_count: int, pairs: np.ndarray, probabilities: np.ndarray
         return node
 
     edges = []
-    for index in np.argsort(costs, kind="stable"):
-        a, b = everything[index]
-        for u, v in ((a, b), (twin[a], twin[b])):
-            root_u, root_v = find(u), find(v)
-            if root_u != root_v:
-                parent[root_u] = root_v
-                edges.append((u, v))
+    for a, b in order:
+        if has_midline and twin[a] == b:
+            continue
+        ra, rb, rma, rmb = find(a), find(b), find(twin[a]), find(twin[b])
+        if ra == rb:
+            continue
+        mirrored_is_same = {twin[a], twin[b]} == {a, b}
+        if not mirrored_is_same and (rma == rmb or {rma, rmb} == {ra, rb}):
+            continue
+        parent[ra] = rb
+        edges.append((a, b))
+        if not mirrored_is_same:
+            parent[find(twin[a])] = find(twin[b])
+            edges.append((int(twin[a]), int(twin[b])))
+    for a, b in order:
         if len(edges) == joint_count - 1:
             break
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            parent[ra] = rb
+            edges.append((a, b))
     return np.array(edges, dtype=np.int64).reshape(-1, 2)
 
 
@@ -191,8 +214,12 @@ def _neighbour_ranks(joints: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     ``j``'s, 0 the nearest, as a share of :data:`CANDIDATE_NEIGHBOURS`."""
     distances = np.linalg.norm(joints[:, None, :] - joints[None, :, :], axis=2)
     np.fill_diagonal(distances, np.inf)
-    rank = np.argsort(np.argsort(distances, axis=1), axis=1)
+    # The count of strictly nearer joints: ties (a joint's two twins) share
+    # a rank, so mirrored pairs get the same features.
     i, j = pairs[:, 0], pairs[:, 1]
+    rank = np.zeros(distances.shape, dtype=np.int64)
+    rank[i, j] = (distances[i] < distances[i, j][:, None]).sum(axis=1)
+    rank[j, i] = (distances[j] < distances[j, i][:, None]).sum(axis=1)
     return np.stack([rank[i, j], rank[j, i]], axis=1) / CANDIDATE_NEIGHBOURS
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..nn.convolution import edge_convolution
+from ..nn.convolution import gmedge_block
 from ..nn.layers import mlp
 from .joint_features import JointGraph
 
@@ -41,9 +41,7 @@ def joint_outputs(weights: dict, graph: JointGraph) -> tuple[np.ndarray, np.ndar
     x = mlp(graph.vertex_features, weights, "encoder.", activation=ACTIVATION)
     levels = [x]
     for layer in JOINT_LAYERS:
-        one_ring = edge_convolution(x, graph.mesh_edges, weights, layer + "one_ring.", activation=ACTIVATION)
-        ball = edge_convolution(x, graph.ball_edges, weights, layer + "ball.", activation=ACTIVATION)
-        x = x + mlp(np.concatenate([one_ring, ball], axis=1), weights, layer + "fuse.", activation=ACTIVATION)
+        x = gmedge_block(x, graph.mesh_edges, graph.ball_edges, weights, layer, activation=ACTIVATION)
         levels.append(x)
     shape = mlp(x, weights, "shape.", activation=ACTIVATION).max(axis=0, keepdims=True)
     joined = np.concatenate(levels + [np.repeat(shape, n, axis=0)], axis=1)

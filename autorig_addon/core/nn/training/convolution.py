@@ -1,7 +1,8 @@
 """Edge convolution in torch: the training twin of
 :mod:`autorig_addon.core.nn.convolution` (message ``MLP([x_i, x_j - x_i])``
 on every edge ``j -> i``, aggregated at the receiver, max by default; the
-MLP's first linear layer computed per node and gathered, as there).
+MLP's first linear layer computed per node and gathered, as there), and
+RigNet's GMEdgeConv block built from it (:class:`GMEdgeBlock`).
 """
 
 from __future__ import annotations
@@ -55,6 +56,33 @@ class EdgeConv(nn.Module):
         first = self.mlp.linears[0]
         hidden = first_layer_per_edge(x, edges, first.weight, first.bias)
         return self.aggregate(self.mlp(hidden, first_linear_applied=True), edges[1], x.shape[0])
+
+
+class GMEdgeBlock(nn.Module):
+    """RigNet's GMEdgeConv block, residual included (twin of
+    :func:`autorig_addon.core.nn.convolution.gmedge_block`): max EdgeConvs
+    over the mesh one-ring (``one_ring.``) and over geodesic balls
+    (``ball.``), concatenated, fused by one linear layer and activation
+    (``fuse.``) and added to the input.
+
+    Parameters
+    ----------
+    channels : int, node feature width ``c`` (in and out)
+    activation : str, every layer's activation (:class:`.layers.MLP`)
+    """
+
+    def __init__(self, channels: int, *, activation: str = "relu"):
+        super().__init__()
+        # Built in this order, so a seeded network's initial parameters do not change.
+        self.one_ring = EdgeConv(channels, [channels], aggregation="max", activation=activation)
+        self.ball = EdgeConv(channels, [channels], aggregation="max", activation=activation)
+        self.fuse = MLP([2 * channels, channels], activation=activation)
+
+    def forward(self, x: torch.Tensor, mesh_edges: torch.Tensor, ball_edges: torch.Tensor) -> torch.Tensor:
+        """(n, c) features, (2, e) and (2, b) int64 edge indices give (n, c)."""
+        one_ring = self.one_ring(x, mesh_edges)
+        ball = self.ball(x, ball_edges)
+        return x + self.fuse(torch.cat([one_ring, ball], dim=1))
 
 
 class MultiAggregatorConv(nn.Module):

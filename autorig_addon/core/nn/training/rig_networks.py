@@ -14,7 +14,7 @@ from torch import nn
 from ...rigging.connectivity import PAIR_FEATURES, ROOT_FEATURES, STD_FLOOR
 from ...rigging.joint_features import VERTEX_FEATURES
 from ...rigging.joint_network import ACTIVATION
-from .convolution import EdgeConv
+from .convolution import GMEdgeBlock
 from .layers import MLP
 
 
@@ -29,11 +29,7 @@ class JointNetwork(nn.Module):
         super().__init__()
         self.encoder = _mlp(VERTEX_FEATURES, 2 * width, width)
         for layer in ("gmedge1", "gmedge2", "gmedge3"):
-            block = nn.Module()
-            block.one_ring = EdgeConv(width, [width], aggregation="max", activation=ACTIVATION)
-            block.ball = EdgeConv(width, [width], aggregation="max", activation=ACTIVATION)
-            block.fuse = _mlp(2 * width, width)
-            setattr(self, layer, block)
+            setattr(self, layer, GMEdgeBlock(width, activation=ACTIVATION))
         self.shape = _mlp(width, 2 * width)
         self.offset = _mlp(6 * width, 2 * width, width, 3, last=False)
         self.attention = _mlp(6 * width, width, 1, last=False)
@@ -44,7 +40,7 @@ class JointNetwork(nn.Module):
         x = self.encoder(features)
         levels = [x]
         for block in (self.gmedge1, self.gmedge2, self.gmedge3):
-            x = x + block.fuse(torch.cat([block.one_ring(x, mesh_edges), block.ball(x, ball_edges)], dim=1))
+            x = block(x, mesh_edges, ball_edges)
             levels.append(x)
         shape = self.shape(x).max(dim=0, keepdim=True).values
         joined = torch.cat(levels + [shape.expand(n, -1)], dim=1)

@@ -3,8 +3,8 @@
 Each run: fixed seed, Adam with a cosine learning-rate schedule.
 
 * ``joints``: one character per step, turned by a random angle about the up
-  axis (within :data:`TURN_DEGREES`) and mirrored with probability one half
-  (the feature columns of :data:`...rigging.joint_features.VERTEX_VECTORS`
+  axis and mirrored with probability one half (:mod:`.augmentation`; the
+  feature columns of :data:`...rigging.joint_features.VERTEX_VECTORS`
   and the targets turn with it). Loss: the L1 distance between each moved
   vertex and its target joint, plus the binary cross-entropy of the
   attention against the voting vertices (weighted so voters and non-voters
@@ -19,7 +19,6 @@ Each run: fixed seed, Adam with a cosine learning-rate schedule.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from typing import Callable
@@ -34,11 +33,10 @@ from ...rigging.joint_network import joint_outputs
 from ...rigging.mean_shift import mean_shift_modes
 from ...rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from ...rigging.training_set import RigExample
+from .augmentation import turn_and_mirror, turned_columns
 from .export import module_weights
 from .rig_networks import NETWORKS
 
-#: Largest turn about the up axis applied to a training character (degrees).
-TURN_DEGREES = 15.0
 #: Weight decay of Adam.
 WEIGHT_DECAY = 1e-5
 #: Weight of the attention loss beside the offset loss.
@@ -50,31 +48,13 @@ JOINT_JITTER = 0.01
 #: Jittered copies of each example's joints.
 JITTER_COPIES = 4
 #: The shipped runs' settings: epochs and Adam's starting learning rate.
-TRAINING_SETTINGS = {"joints": (16, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
+TRAINING_SETTINGS = {"joints": (22, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
 
 Log = Callable[[str], None]
 
 
 def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
-
-
-def _turn_and_mirror(rng: np.random.Generator) -> np.ndarray:
-    angle = math.radians(rng.uniform(-TURN_DEGREES, TURN_DEGREES))
-    cosine, sine = math.cos(angle), math.sin(angle)
-    matrix = np.array([[cosine, -sine, 0.0], [sine, cosine, 0.0], [0.0, 0.0, 1.0]])
-    if rng.random() < 0.5:
-        matrix = matrix @ np.diag([-1.0, 1.0, 1.0])
-    return matrix
-
-
-def _turned_columns(features: torch.Tensor, matrix: torch.Tensor) -> torch.Tensor:
-    pieces, position = [], 0
-    for start in VERTEX_VECTORS:
-        pieces += [features[:, position:start], features[:, start:start + 3] @ matrix.T]
-        position = start + 3
-    pieces.append(features[:, position:])
-    return torch.cat(pieces, dim=1)
 
 
 def clustered_joints(weights: dict, example: RigExample, bandwidth: float, density_threshold: float) -> np.ndarray:
@@ -125,8 +105,8 @@ def train_joint_network(train: list, holdout: list, *, epochs: int, learning_rat
         losses = []
         for index in rng.permutation(len(tensors)):
             features, mesh_edges, ball_edges, vertices, target, attention = tensors[index]
-            matrix = torch.as_tensor(_turn_and_mirror(rng), dtype=torch.float32, device=device)
-            offsets, logits = model(_turned_columns(features, matrix), mesh_edges, ball_edges)
+            matrix = torch.as_tensor(turn_and_mirror(rng), dtype=torch.float32, device=device)
+            offsets, logits = model(turned_columns(features, VERTEX_VECTORS, matrix), mesh_edges, ball_edges)
             moved = vertices @ matrix.T + offsets
             offset_loss = (moved - target @ matrix.T).abs().sum(dim=1).mean()
             voters = attention.sum().clamp_min(1.0)

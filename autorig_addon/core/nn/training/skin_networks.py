@@ -22,7 +22,7 @@ from ...skinning.learned.features import (
 )
 from ...skinning.learned.networks import ACTIVATION
 from .aggregation import gather, segment_max, segment_mean
-from .convolution import EdgeConv, MultiAggregatorConv
+from .convolution import GMEdgeBlock, MultiAggregatorConv
 from .layers import MLP
 
 
@@ -79,11 +79,7 @@ class RigNetSkin(SkinNetwork):
         super().__init__()
         self.encoder = _mlp(VERTEX_FEATURES + CANDIDATE_BONES * PAIR_FEATURES, 2 * width, width)
         for layer in ("gmedge1", "gmedge2"):
-            block = nn.Module()
-            block.one_ring = EdgeConv(width, [width], aggregation="max", activation=ACTIVATION)
-            block.ball = EdgeConv(width, [width], aggregation="max", activation=ACTIVATION)
-            block.fuse = _mlp(2 * width, width)
-            setattr(self, layer, block)
+            setattr(self, layer, GMEdgeBlock(width, activation=ACTIVATION))
         self.shape = _mlp(width, width)
         self.scores = _mlp(4 * width, width, CANDIDATE_BONES, last=False)
         self.start_from_prior(self.scores)
@@ -94,9 +90,7 @@ class RigNetSkin(SkinNetwork):
         x = self.encoder(x)
         levels = [x]
         for block in (self.gmedge1, self.gmedge2):
-            one_ring = block.one_ring(x, graph.mesh_edges)
-            ball = block.ball(x, graph.ball_edges)
-            x = x + block.fuse(torch.cat([one_ring, ball], dim=1))
+            x = block(x, graph.mesh_edges, graph.ball_edges)
             levels.append(x)
         shape = self.shape(x).max(dim=0, keepdim=True).values
         joined = torch.cat(levels + [shape.expand(n, -1)], dim=1)

@@ -2,8 +2,8 @@
 
 One run: fixed seed, Adam with a cosine learning-rate schedule, one
 character per step. Each step turns the character by a random angle about
-the up axis (within :data:`TURN_DEGREES`) and mirrors it left-right with
-probability one half, applied to the feature vectors
+the up axis and mirrors it left-right with probability one half
+(:func:`.augmentation.turn_and_mirror`), applied to the feature vectors
 (:data:`~autorig_addon.core.skinning.learned.features.VERTEX_VECTORS` and
 friends): neither changes a distance, so no example has to be rebuilt. The
 loss is the cross-entropy between the artist's weights of each vertex's
@@ -32,12 +32,10 @@ from ...skinning.learned.training_set import DEFAULT_LEARNING_RATE
 from ...skinning.learned.features import BONE_VECTORS, PAIR_VECTORS, VERTEX_VECTORS, SkinGraph
 from ...skinning.learned.networks import SCORE_FUNCTIONS, candidate_weights
 from ...skinning.learned.predict import dense_weights, finished_weights
+from .augmentation import turn_and_mirror, turned_columns
 from .export import module_weights
 from .skin_networks import NETWORKS, graph_tensors
 
-#: Largest turn about the up axis applied to a training character (degrees):
-#: inputs are normalised to face -y, so only small deviations remain.
-TURN_DEGREES = 15.0
 #: Weight decay of Adam (a small network on few characters).
 WEIGHT_DECAY = 1e-5
 
@@ -63,32 +61,12 @@ class TrainingRecord:
         return {key: value for key, value in self.__dict__.items()}
 
 
-def _rotation_and_mirror(rng: np.random.Generator) -> np.ndarray:
-    angle = math.radians(rng.uniform(-TURN_DEGREES, TURN_DEGREES))
-    cosine, sine = math.cos(angle), math.sin(angle)
-    matrix = np.array([[cosine, -sine, 0.0], [sine, cosine, 0.0], [0.0, 0.0, 1.0]])
-    if rng.random() < 0.5:
-        matrix = matrix @ np.diag([-1.0, 1.0, 1.0])
-    return matrix
-
-
-def _turned(columns: torch.Tensor, starts: tuple, matrix: torch.Tensor) -> torch.Tensor:
-    """``columns`` with each 3-vector starting at a column of ``starts`` turned by ``matrix``."""
-    pieces, position = [], 0
-    for start in starts:
-        pieces.append(columns[..., position:start])
-        pieces.append(columns[..., start:start + 3] @ matrix.T)
-        position = start + 3
-    pieces.append(columns[..., position:])
-    return torch.cat(pieces, dim=-1)
-
-
 def augmented(graph: SkinGraph, matrix: np.ndarray) -> SkinGraph:
     """The graph (of tensors) turned/mirrored by the (3, 3) ``matrix``."""
     turn = torch.as_tensor(matrix, dtype=graph.vertex_features.dtype, device=graph.vertex_features.device)
-    return replace(graph, vertex_features=_turned(graph.vertex_features, VERTEX_VECTORS, turn),
-                   pair_features=_turned(graph.pair_features, PAIR_VECTORS, turn),
-                   bone_features=_turned(graph.bone_features, BONE_VECTORS, turn))
+    return replace(graph, vertex_features=turned_columns(graph.vertex_features, VERTEX_VECTORS, turn),
+                   pair_features=turned_columns(graph.pair_features, PAIR_VECTORS, turn),
+                   bone_features=turned_columns(graph.bone_features, BONE_VECTORS, turn))
 
 
 def candidate_cross_entropy(predicted: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
@@ -155,7 +133,7 @@ def train_network(network: str, train: list, holdout: list, *, epochs: int, seed
         losses = []
         for index in rng.permutation(len(tensors)):
             graph, target = tensors[index]
-            loss = candidate_cross_entropy(model(augmented(graph, _rotation_and_mirror(rng))), target)
+            loss = candidate_cross_entropy(model(augmented(graph, turn_and_mirror(rng))), target)
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...nn.aggregation import gather, segment_max, segment_mean
-from ...nn.convolution import edge_convolution, multi_aggregator_convolution
+from ...nn.convolution import gmedge_block, multi_aggregator_convolution
 from ...nn.layers import mlp
 from .features import PRIOR_FLOOR, SkinGraph
 
@@ -57,9 +57,7 @@ def rignet_scores(weights: dict, graph: SkinGraph) -> np.ndarray:
     x = mlp(x, weights, "encoder.", activation=ACTIVATION)
     levels = [x]
     for layer in ("gmedge1.", "gmedge2."):
-        one_ring = edge_convolution(x, graph.mesh_edges, weights, layer + "one_ring.", activation=ACTIVATION)
-        ball = edge_convolution(x, graph.ball_edges, weights, layer + "ball.", activation=ACTIVATION)
-        x = x + mlp(np.concatenate([one_ring, ball], axis=1), weights, layer + "fuse.", activation=ACTIVATION)
+        x = gmedge_block(x, graph.mesh_edges, graph.ball_edges, weights, layer, activation=ACTIVATION)
         levels.append(x)
     shape = mlp(x, weights, "shape.", activation=ACTIVATION).max(axis=0, keepdims=True)
     joined = np.concatenate(levels + [np.repeat(shape, n, axis=0)], axis=1)
