@@ -132,6 +132,16 @@ sleeve, _, _ = fx.make_sleeve(with_button=False)
 bpy.context.view_layer.update()
 transferred = bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve")
 
+# Auto-Rig on a bare tube: the skeleton networks and the learned skin, numpy only.
+tube_vertices, tube_faces = fx.cylinder_geometry(fx.BODY_RADIUS, 0.0, fx.BODY_HEIGHT, 24, 20, capped=True)
+tube = fx.mesh_object("Tube", tube_vertices, tube_faces)
+bpy.ops.object.select_all(action="DESELECT")
+tube.select_set(True)
+bpy.context.view_layer.objects.active = tube
+rigged = bpy.ops.autorig.auto_rig()
+tube_armatures = [m.object for m in tube.modifiers if m.type == "ARMATURE"]
+tube_bones = [b.name for b in tube_armatures[0].data.bones] if tube_armatures else []
+
 import scipy
 bones = [fx.LOWER_BONE, fx.UPPER_BONE]
 print({prefix!r} + json.dumps({{
@@ -144,6 +154,9 @@ print({prefix!r} + json.dumps({{
     "sleeve_heights": fx.local_positions(sleeve)[:, 2].tolist(),
     "sleeve_weights": fx.group_weights(sleeve, bones).tolist(),
     "armature_modifier": [m.object.name for m in body.modifiers if m.type == "ARMATURE"],
+    "rig_result": sorted(rigged),
+    "tube_bones": tube_bones,
+    "tube_weights": fx.group_weights(tube, tube_bones).tolist() if tube_bones else [],
     "scipy_file": scipy.__file__,
     "addon_file": sys.modules[{module!r}].__file__,
     "repository_addon_loaded": "autorig_addon" in sys.modules,
@@ -256,3 +269,8 @@ def test_installed_zip_skins_without_torch(linux_zip, blender_user_dir):
     np.testing.assert_allclose(sleeve.sum(axis=1), 1.0, atol=ROW_SUM_TOLERANCE)
     sleeve_lower = np.array(used["sleeve_heights"]) < LOWER_REGION_TOP
     assert sleeve_lower.any() and (sleeve[sleeve_lower, 0] > sleeve[sleeve_lower, 1]).all()
+
+    # Auto-Rig predicted a skeleton and bound the tube, without torch.
+    assert used["rig_result"] == ["FINISHED"]
+    assert len(used["tube_bones"]) >= 2
+    np.testing.assert_allclose(np.array(used["tube_weights"]).sum(axis=1), 1.0, atol=ROW_SUM_TOLERANCE)
