@@ -31,7 +31,7 @@ from autorig_addon.core.rigging.predict import JointVotes, cluster_joints, train
 from autorig_addon.core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error  # noqa: E402
 from autorig_addon.core.rigging.training_set import load_example  # noqa: E402
 
-BANDWIDTHS = (0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
+BANDWIDTHS = (0.01, 0.0125, 0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
 THRESHOLDS = (0.0, 0.01, 0.02, 0.05)
 
 

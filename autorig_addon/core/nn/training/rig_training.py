@@ -48,7 +48,7 @@ JOINT_JITTER = 0.01
 #: Jittered copies of each example's joints.
 JITTER_COPIES = 4
 #: The shipped runs' settings: epochs and Adam's starting learning rate.
-TRAINING_SETTINGS = {"joints": (22, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
+TRAINING_SETTINGS = {"joints": (40, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
 
 Log = Callable[[str], None]
 
