@@ -11,6 +11,16 @@ from mathutils import Quaternion, Vector
 
 #: Pixels of one panel (width, height).
 RESOLUTION = (260, 390)
+#: The rigged characters of data_split.json, beside the repository.
+CHARACTERS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data",
+                          "characters")
+#: The validation characters the skinning and rigging pages picture, paths under :data:`CHARACTERS`.
+DOC_CHARACTERS = (
+    "quaternius_glb/single_knight_pack/KnightCharacter.glb",
+    "quaternius_glb/animals_pack/Wolf.glb",
+    "quaternius_glb/dinosaurs_pack/Stegosaurus.glb",
+    "kaykit/Rogue_Hooded.glb",
+)
 
 
 def duplicate(obj, name: str):

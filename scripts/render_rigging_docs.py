@@ -37,16 +37,12 @@ import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from autorig_addon.blender.characters import load_character  # noqa: E402
+from autorig_addon.core.geometry.bounding_box import largest_side  # noqa: E402
 from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, predict_votes, skeleton_from_votes  # noqa: E402
-from docs_render import add_label, mesh_from_arrays, render, save_side_by_side, setup_render, skeleton_objects  # noqa: E402
-
-CHARACTERS = os.path.join(REPO, "..", "shared", "data", "characters")
-DEFAULT_CHARACTERS = (
-    "quaternius_glb/single_knight_pack/KnightCharacter.glb",
-    "quaternius_glb/animals_pack/Wolf.glb",
-    "quaternius_glb/dinosaurs_pack/Stegosaurus.glb",
-    "kaykit/Rogue_Hooded.glb",
+from docs_render import (  # noqa: E402
+    CHARACTERS, DOC_CHARACTERS, add_label, mesh_from_arrays, render, save_side_by_side, setup_render, skeleton_objects,
 )
+
 #: Levels of detail of the bandwidth picture, share of the largest side:
 #: finer than the default, the default, coarser.
 BANDWIDTHS = (0.012, DEFAULT_BANDWIDTH, 0.04)
@@ -114,7 +110,7 @@ def frame(scene, points: np.ndarray, direction, panel_width: int) -> tuple:
 def render_panels(character, skeletons, path: str, out_dir: str) -> None:
     """One panel per (label, skeleton) over the see-through mesh, side by side in ``path``."""
     vertices = character.mesh.vertices
-    size = float((vertices.max(0) - vertices.min(0)).max())
+    size = largest_side(vertices)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.world = bpy.data.worlds.new("background")
@@ -162,8 +158,8 @@ def render_bandwidths(path: str, out_dir: str) -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("characters", nargs="*", default=[os.path.join(CHARACTERS, c) for c in DEFAULT_CHARACTERS])
-    parser.add_argument("--lod-character", default=os.path.join(CHARACTERS, DEFAULT_CHARACTERS[0]),
+    parser.add_argument("characters", nargs="*", default=[os.path.join(CHARACTERS, c) for c in DOC_CHARACTERS])
+    parser.add_argument("--lod-character", default=os.path.join(CHARACTERS, DOC_CHARACTERS[0]),
                         help="character of the bandwidth picture")
     parser.add_argument("--out", default=os.path.join(REPO, "docs", "images"))
     args = parser.parse_args(argv)

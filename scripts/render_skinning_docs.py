@@ -29,15 +29,10 @@ from autorig_addon.blender.characters import load_character  # noqa: E402
 from autorig_addon.core.skinning.geometric import geometric_weights  # noqa: E402
 from autorig_addon.core.skinning.learned.predict import learned_weights  # noqa: E402
 from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD  # noqa: E402
-from docs_render import bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render  # noqa: E402
-
-CHARACTERS = os.path.join(REPO, "..", "shared", "data", "characters")
-DEFAULT_CHARACTERS = (
-    "quaternius_glb/single_knight_pack/KnightCharacter.glb",
-    "quaternius_glb/animals_pack/Wolf.glb",
-    "quaternius_glb/dinosaurs_pack/Stegosaurus.glb",
-    "kaykit/Rogue_Hooded.glb",
+from docs_render import (  # noqa: E402
+    CHARACTERS, DOC_CHARACTERS, bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render,
 )
+
 
 
 def render_character(path: str, out_dir: str) -> None:
@@ -67,7 +62,7 @@ def render_character(path: str, out_dir: str) -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("characters", nargs="*", default=[os.path.join(CHARACTERS, c) for c in DEFAULT_CHARACTERS])
+    parser.add_argument("characters", nargs="*", default=[os.path.join(CHARACTERS, c) for c in DOC_CHARACTERS])
     parser.add_argument("--out", default=os.path.join(REPO, "docs", "images"))
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)

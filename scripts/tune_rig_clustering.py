@@ -26,9 +26,7 @@ from autorig_addon.core.evaluation.joint_matching import JOINT_MATCH_FRACTION, j
 from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j  # noqa: E402
 from autorig_addon.core.nn.training.rig_run import default_examples_dir  # noqa: E402
 from autorig_addon.core.nn.training.skin_run import HOLDOUT_EVERY  # noqa: E402
-from autorig_addon.core.rigging.joint_network import joint_outputs  # noqa: E402
-from autorig_addon.core.rigging.predict import JointVotes, cluster_joints, trained_network  # noqa: E402
-from autorig_addon.core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error  # noqa: E402
+from autorig_addon.core.rigging.predict import cluster_joints, graph_votes, trained_network  # noqa: E402
 from autorig_addon.core.rigging.training_set import load_example  # noqa: E402
 
 BANDWIDTHS = (0.01, 0.0125, 0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
@@ -43,9 +41,7 @@ def main() -> None:
     votes = []
     for name in held:
         example = load_example(folder / f"{name.replace('/', '__')}#0.npz")
-        offsets, attention = joint_outputs(weights, example.graph)
-        symmetric = mirror_error(example.graph.vertices, 0) <= SYMMETRY_TOLERANCE
-        votes.append((JointVotes(example.graph.vertices + offsets, attention, None, np.eye(4), symmetric), example))
+        votes.append((graph_votes(weights, example.graph), example))
     print("| bandwidth | threshold | CD-J2J | IoU | joints predicted / artist's |")
     print("|---|---|---|---|---|")
     for bandwidth in BANDWIDTHS:

@@ -1,9 +1,10 @@
-"""``python -m autorig_addon train``: train the skinning networks.
+"""``python -m autorig_addon train``: train the skinning and skeleton networks.
 
 ``train samples`` builds the cached samples of the characters (needs the
-``bpy`` module); ``train skin --model NAME`` trains one network from those
-samples alone (torch, no Blender: it also runs on a machine without bpy)
-and writes its weights where the extension reads them. Fixed seed, so the
+``bpy`` module); ``train skin --model NAME`` and ``train rig --model NAME``
+train one network from those samples alone (torch, no Blender: it also
+runs on a machine without bpy) and write its weights where the extension
+reads them. Fixed seed, so the
 same command gives the same weights on the same device; see
 ``docs/models.md``.
 """
@@ -16,13 +17,11 @@ import sys
 from pathlib import Path
 
 from ..core.dataset.cache import default_cache_dir
-from ..core.rigging.predict import NETWORK_FILES
+from ..core.rigging import training_set as rig_training_set
+from ..core.rigging.predict import NETWORK_NAMES as RIG_NETWORK_NAMES
 from ..core.skinning.learned.predict import NETWORK_NAMES
 from ..core.skinning.learned.training_set import TRAINING_SETTINGS
 from .exit_codes import EXIT_OK
-
-#: The skeleton networks ``train rig --model`` trains.
-RIG_NETWORK_NAMES = tuple(NETWORK_FILES)
 
 NAME = "train"
 HELP = "Train the skinning and skeleton networks from cached samples of the training characters"
@@ -38,7 +37,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model", choices=NETWORK_NAMES + RIG_NETWORK_NAMES,
                         help=f"The network to train: train skin {'|'.join(NETWORK_NAMES)}; "
                              f"train rig {'|'.join(RIG_NETWORK_NAMES)}")
-    shipped = ", ".join(f"{name} {epochs} epochs at {rate:g}" for name, (epochs, rate) in TRAINING_SETTINGS.items())
+    shipped = ", ".join(f"{name} {epochs} epochs at {rate:g}" for name, (epochs, rate)
+                        in {**TRAINING_SETTINGS, **rig_training_set.TRAINING_SETTINGS}.items())
     parser.add_argument("--epochs", type=int, default=None,
                         help=f"Epochs (default: the shipped weights' run: {shipped})")
     parser.add_argument("--learning-rate", type=float, default=None,
@@ -53,10 +53,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--characters", type=Path, default=DEFAULT_CHARACTERS,
                         help="Folder of the rigged characters (train samples; default ../shared/data/characters)")
     parser.add_argument("--output", type=Path, default=None,
-                        help="Weights file to write (default: the extension's own, core/skinning/learned/trained/)")
-    parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are")
+                        help="Weights file to write (default: the extension's own, core/skinning/learned/trained/ "
+                             "or core/rigging/trained/)")
+    parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are (train skin)")
     parser.add_argument("--procedural", type=int, default=0,
-                        help="Also train on this many procedural characters (seeds 0 to N-1; default 0)")
+                        help="Also train on this many procedural characters (train skin; seeds 0 to N-1; default 0)")
 
 
 def run(args: argparse.Namespace) -> int:

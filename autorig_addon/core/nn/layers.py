@@ -49,6 +49,12 @@ def identity(x: np.ndarray) -> np.ndarray:
     return x
 
 
+def sigmoid(x: np.ndarray) -> np.ndarray:
+    """The logistic function ``1 / (1 + exp(-x))``, written with ``tanh`` so
+    that no ``exp`` overflows for large ``|x|``."""
+    return 0.5 * (1.0 + np.tanh(0.5 * x))
+
+
 #: Activations by name, for layers that take theirs as a setting.
 ACTIVATIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "relu": relu,

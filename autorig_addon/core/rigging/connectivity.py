@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..nn.layers import mlp
+from ..nn.layers import mlp, sigmoid
 from .joint_features import SolidDepth
 from .joint_network import ACTIVATION
 
@@ -48,6 +48,9 @@ PAIR_FEATURES = 19
 ROOT_FEATURES = 9
 #: Least spread a feature is divided by when standardised.
 STD_FLOOR = 1e-4
+#: Radius within which :func:`root_features` counts a joint's neighbours
+#: (share of the largest side).
+ROOT_NEIGHBOURHOOD = 0.1
 
 
 def candidate_pairs(joints: np.ndarray, neighbours: int = CANDIDATE_NEIGHBOURS) -> np.ndarray:
@@ -103,10 +106,10 @@ def pair_features(joints: np.ndarray, pairs: np.ndarray, solid: SolidDepth, mirr
 def root_features(joints: np.ndarray, solid: SolidDepth) -> np.ndarray:
     """(j, ROOT_FEATURES) float32: |x|, y, z, depth, distance to the joints'
     centroid, height and depth over the joints' means, share of joints
-    within a tenth of the largest side, depth rank (0 the deepest)."""
+    within :data:`ROOT_NEIGHBOURHOOD`, depth rank (0 the deepest)."""
     depth = solid.at(joints)
     centroid = joints.mean(axis=0)
-    near = cKDTree(joints).query_ball_point(joints, 0.1, return_length=True) / max(len(joints), 1)
+    near = cKDTree(joints).query_ball_point(joints, ROOT_NEIGHBOURHOOD, return_length=True) / max(len(joints), 1)
     depth_rank = np.argsort(np.argsort(-depth)) / max(len(joints) - 1, 1)
     columns = [np.abs(joints[:, 0]), joints[:, 1], joints[:, 2], depth, np.linalg.norm(joints - centroid, axis=1),
                joints[:, 2] - centroid[2], depth - depth.mean(), near, depth_rank]
@@ -122,7 +125,7 @@ def standardised_mlp(weights: dict, features: np.ndarray) -> np.ndarray:
 
 def bone_probabilities(weights: dict, features: np.ndarray) -> np.ndarray:
     """(p,) probability that each scored pair is a bone."""
-    return 0.5 * (1.0 + np.tanh(0.5 * standardised_mlp(weights, features)))
+    return sigmoid(standardised_mlp(weights, features))
 
 
 def root_scores(weights: dict, features: np.ndarray) -> np.ndarray:

@@ -16,17 +16,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..nn.convolution import gmedge_block
-from ..nn.layers import mlp
+from ..nn.layers import mlp, sigmoid
 from .joint_features import JointGraph
 
 #: Activation of every hidden layer.
 ACTIVATION = "leaky_relu"
 #: The GMEdgeConv layers, by parameter prefix.
 JOINT_LAYERS = ("gmedge1.", "gmedge2.", "gmedge3.")
-
-
-def sigmoid(x: np.ndarray) -> np.ndarray:
-    return 0.5 * (1.0 + np.tanh(0.5 * x))
 
 
 def joint_outputs(weights: dict, graph: JointGraph) -> tuple[np.ndarray, np.ndarray]:

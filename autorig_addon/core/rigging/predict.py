@@ -20,7 +20,7 @@ turned for the network; one lying on its side is refused with a message.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -28,6 +28,7 @@ import numpy as np
 
 from ..dataset.normalise import apply_transform, normalisation_transform
 from ..errors import InputError
+from ..geometry.outliers import without_vertices
 from ..geometry.proxy import simplified_proxy
 from ..nn.weights_io import load_weights
 from ..progress import ProgressCallback, report
@@ -36,7 +37,7 @@ from ..types import Mesh, Skeleton
 from .connectivity import (
     bone_probabilities, candidate_pairs, oriented_tree, pair_features, root_features, root_scores, spanning_tree,
 )
-from .joint_features import PROXY_VERTICES, SolidDepth, joint_graph, solid_depth
+from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .joint_network import joint_outputs
 from .mean_shift import mean_shift_modes
 from .role_names import role_names
@@ -45,8 +46,8 @@ from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_p
 #: Mean-shift bandwidth, share of the character's largest side: the level
 #: of detail (smaller: more joints). On the held-out training characters
 #: (``scripts/tune_rig_clustering.py``, docs/models.md) CD-J2J is flat from
-#: 0.01 to 0.0175 (0.0351 to 0.0358) while the joint count grows from 1.11
-#: to 3.3 times the artists'; the default is the coarsest bandwidth within
+#: 0.01 to 0.0175 (0.0351 to 0.0358) while the joint count falls from 3.3
+#: to 1.11 times the artists'; the default is the coarsest bandwidth within
 #: 0.001 of the best CD-J2J.
 DEFAULT_BANDWIDTH = 0.0175
 MIN_BANDWIDTH = 0.01
@@ -75,6 +76,7 @@ LEAF_SAMPLES = 16
 #: The shipped weights of the three networks.
 TRAINED_FOLDER = Path(__file__).resolve().parent / "trained"
 NETWORK_FILES = {"joints": "joints.npz", "bones": "bones.npz", "root": "root.npz"}
+NETWORK_NAMES = tuple(NETWORK_FILES)
 
 
 @dataclass(frozen=True)
@@ -86,7 +88,7 @@ class JointVotes:
     ----------
     points : (n, 3) float64, votes (moved proxy vertices), normalised frame
     attention : (n,) float64 in (0, 1)
-    solid : SolidDepth of the normalised proxy
+    solid : SolidDepth of the normalised proxy (None: votes only clustered, never connected)
     transform : (4, 4) float64, from the mesh's space to the normalised frame
     symmetric : bool, whether the shape is left-right symmetric
     notes : tuple of str, what was detected or decided
@@ -154,10 +156,10 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                          f"surface of at least {MIN_FACES}.")
     weights = trained_network("joints")
     report(progress, 0.0, "Simplifying the mesh")
-    used = np.unique(mesh.triangles)
-    remap = np.zeros(mesh.vertex_count, dtype=np.int64)
-    remap[used] = np.arange(len(used))
-    surface = Mesh(mesh.vertices[used], remap[mesh.triangles])
+    # Vertices in no face have no surface to read; the proxy would keep them.
+    faceless = np.ones(mesh.vertex_count, dtype=bool)
+    faceless[mesh.triangles] = False
+    surface = Mesh(*without_vertices(mesh.vertices, mesh.triangles, faceless)[1:])
     if not np.all(np.isfinite(surface.vertices)):
         raise InputError("The mesh has vertices at NaN or infinite positions; fix them before predicting a skeleton.")
     proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
@@ -169,16 +171,37 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append("The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 "
                      "of its own space).")
     normalised = Mesh(apply_transform(proxy.vertices, transform), proxy.triangles)
-    symmetric = mirror_error(normalised.vertices, 0) <= SYMMETRY_TOLERANCE
-    if not symmetric:
-        notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 0.3, "Measuring the shape")
     solid = solid_depth(normalised)
     graph = joint_graph(normalised, solid)
     report(progress, 0.6, "Running the joint network")
-    offsets, attention = joint_outputs(weights, graph)
+    votes = graph_votes(weights, graph, solid, transform)
+    if not votes.symmetric:
+        notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
-    return JointVotes(graph.vertices + offsets, attention, solid, transform, symmetric, tuple(notes))
+    return replace(votes, notes=tuple(notes))
+
+
+def graph_votes(weights: dict, graph: JointGraph, solid: SolidDepth | None = None,
+                transform: np.ndarray | None = None) -> JointVotes:
+    """The joint network's votes on a graph in the normalised frame.
+
+    Parameters
+    ----------
+    weights : dict, the joint network's weights (:func:`trained_network` or a training run's)
+    graph : JointGraph of the normalised proxy (:func:`.joint_features.joint_graph`)
+    solid : its SolidDepth, when the votes will be connected into a skeleton
+    transform : (4, 4) float64 from the mesh's space to the normalised frame; default identity
+
+    Returns
+    -------
+    JointVotes, symmetric when the graph's vertices are left-right symmetric
+    (:data:`.symmetry.SYMMETRY_TOLERANCE`), without notes.
+    """
+    offsets, attention = joint_outputs(weights, graph)
+    symmetric = mirror_error(graph.vertices, 0) <= SYMMETRY_TOLERANCE
+    return JointVotes(graph.vertices + offsets, attention, solid, np.eye(4) if transform is None else transform,
+                      symmetric)
 
 
 def cluster_joints(votes: JointVotes, bandwidth: float, density_threshold: float,
@@ -232,7 +255,8 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
                          f"{MAX_DENSITY_THRESHOLD}, got {density_threshold}.")
     joints, mirror = cluster_joints(votes, bandwidth, density_threshold, symmetry)
     if not len(joints):
-        raise InputError("No joint was found: lower the density threshold.")
+        hint = "lower the density threshold" if density_threshold > 0 else "the network found no joint in this shape"
+        raise InputError(f"No joint was found: {hint}.")
     order, parents = connect_joints(joints, mirror, votes.solid)
     joints = joints[order]
     position = np.empty_like(order)

@@ -45,6 +45,10 @@ STRETCHED_VARIANTS = 4
 STRETCH_RANGE = (0.8, 1.25)
 #: Bumped whenever examples change, so old cached ones are rebuilt.
 EXAMPLE_FORMAT_VERSION = 3
+#: Epochs and Adam's starting learning rate (cosine schedule down to 0) of
+#: each skeleton network's training run unless told: the settings its
+#: shipped weights were trained with (docs/models.md).
+TRAINING_SETTINGS = {"joints": (40, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
 
 
 @dataclass(frozen=True)

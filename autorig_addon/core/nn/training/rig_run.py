@@ -18,17 +18,13 @@ from typing import Optional
 
 import torch
 
-from ...dataset.cache import default_cache_dir
+from ...dataset.cache import default_cache_dir, training_samples
 from ...errors import InputError
 from ...nn.weights_io import save_weights
-from ...rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, NETWORK_FILES, trained_weights_path
-from ...rigging.training_set import EXAMPLE_FORMAT_VERSION, build_examples
-from .rig_training import TRAINING_SETTINGS, train_connectivity_network, train_joint_network
-from ...dataset.cache import training_samples
+from ...rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, NETWORK_NAMES, trained_weights_path
+from ...rigging.training_set import EXAMPLE_FORMAT_VERSION, TRAINING_SETTINGS, build_examples
+from .rig_training import train_connectivity_network, train_joint_network
 from .skin_run import HOLDOUT_EVERY, TRAINING_THREADS, pick_device
-
-#: The networks ``train rig --model`` accepts.
-RIG_NETWORKS = tuple(NETWORK_FILES)
 
 
 def default_examples_dir(seed: int) -> Path:
@@ -39,8 +35,8 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
                      epochs: Optional[int] = None, learning_rate: Optional[float] = None, seed: int = 0,
                      device: str = "auto", output: Optional[Path] = None) -> dict:
     """Train ``network`` (``joints``, ``bones`` or ``root``) and write its weights; returns the record."""
-    if network not in RIG_NETWORKS:
-        raise InputError(f"Unknown skeleton network '{network}': use one of {RIG_NETWORKS}.")
+    if network not in NETWORK_NAMES:
+        raise InputError(f"Unknown skeleton network '{network}': use one of {NETWORK_NAMES}.")
     torch.set_num_threads(TRAINING_THREADS)
     shipped_epochs, shipped_rate = TRAINING_SETTINGS[network]
     epochs = epochs or shipped_epochs

@@ -1,6 +1,7 @@
 """Training the skeleton networks from their examples (torch; never in Blender).
 
-Each run: fixed seed, Adam with a cosine learning-rate schedule.
+Each run: fixed seed, Adam with a cosine learning-rate schedule
+(:class:`.optimisation.CosineAdam`).
 
 * ``joints``: one character per step, turned by a random angle about the up
   axis and mirrored with probability one half (:mod:`.augmentation`; the
@@ -8,9 +9,10 @@ Each run: fixed seed, Adam with a cosine learning-rate schedule.
   and the targets turn with it). Loss: the L1 distance between each moved
   vertex and its target joint, plus the binary cross-entropy of the
   attention against the voting vertices (weighted so voters and non-voters
-  count alike). After each epoch the numpy forward pass and the mean shift
-  at the default bandwidth run on the held-out training characters; the
-  epoch with the lowest CD-J2J of the clustered joints is kept.
+  count alike, up to :data:`MAX_VOTER_WEIGHT`). After each epoch the numpy
+  forward pass and the mean shift at the default bandwidth run on the
+  held-out training characters; the epoch with the lowest CD-J2J of the
+  clustered joints is kept.
 * ``bones`` and ``root``: the reference joints of every example, jittered
   (:data:`JOINT_JITTER`) a few times (:data:`JITTER_COPIES`), give pair and
   joint features once; full-batch training; the epoch with the lowest
@@ -27,28 +29,27 @@ import numpy as np
 import torch
 
 from ...evaluation.skeleton_metrics import chamfer_j2j
-from ...rigging.connectivity import candidate_pairs, pair_features, root_features
+from ...rigging.connectivity import bone_probabilities, candidate_pairs, pair_features, root_features, root_scores
 from ...rigging.joint_features import VERTEX_VECTORS, solid_depth
-from ...rigging.joint_network import joint_outputs
-from ...rigging.mean_shift import mean_shift_modes
+from ...rigging.predict import cluster_joints, graph_votes
 from ...rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from ...rigging.training_set import RigExample
 from .augmentation import turn_and_mirror, turned_columns
 from .export import module_weights
+from .optimisation import CosineAdam
 from .rig_networks import NETWORKS
 
-#: Weight decay of Adam.
-WEIGHT_DECAY = 1e-5
 #: Weight of the attention loss beside the offset loss.
 ATTENTION_LOSS_WEIGHT = 0.5
+#: Most a voting vertex's attention loss is weighted over a non-voter's
+#: (the weight is the ratio of non-voters to voters, clamped to [1, this]).
+MAX_VOTER_WEIGHT = 20.0
 #: Standard deviation of the noise added to reference joints when training
 #: the bone and root networks (share of the largest side): predicted joints
 #: are about this far off.
 JOINT_JITTER = 0.01
 #: Jittered copies of each example's joints.
 JITTER_COPIES = 4
-#: The shipped runs' settings: epochs and Adam's starting learning rate.
-TRAINING_SETTINGS = {"joints": (40, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
 
 Log = Callable[[str], None]
 
@@ -59,14 +60,7 @@ def _stderr(line: str) -> None:
 
 def clustered_joints(weights: dict, example: RigExample, bandwidth: float, density_threshold: float) -> np.ndarray:
     """The joints the predictor would find on ``example`` (normalised frame)."""
-    offsets, attention = joint_outputs(weights, example.graph)
-    points = example.graph.vertices + offsets
-    if mirror_error(example.graph.vertices, 0) <= SYMMETRY_TOLERANCE:
-        points = np.concatenate([points, mirror_points(points)])
-        attention = np.concatenate([attention, attention])
-        joints, _ = mean_shift_modes(points, attention, bandwidth, density_threshold)
-        return symmetric_joints(joints, 0.5 * bandwidth)[0] if len(joints) else joints
-    return mean_shift_modes(points, attention, bandwidth, density_threshold)[0]
+    return cluster_joints(graph_votes(weights, example.graph), bandwidth, density_threshold, True)[0]
 
 
 def holdout_j2j(weights: dict, holdout: list, bandwidth: float, density_threshold: float) -> float:
@@ -90,8 +84,7 @@ def train_joint_network(train: list, holdout: list, *, epochs: int, learning_rat
         tensors.append(tuple(torch.as_tensor(np.asarray(value)).to(device) for value in (
             graph.vertex_features, graph.mesh_edges, graph.ball_edges, graph.vertices.astype(np.float32),
             example.target_points, example.attention)))
-    optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate, weight_decay=WEIGHT_DECAY)
-    schedule = torch.optim.lr_scheduler.CosineAnnealingLR(optimiser, T_max=epochs * len(tensors))
+    optimiser = CosineAdam(model.parameters(), learning_rate, epochs * len(tensors))
     record = {"network": "joints", "seed": seed, "epochs": epochs, "learning_rate": learning_rate, "device": device,
               "train_examples": len(train), "holdout": sorted({e.name.split("#")[0] for e in holdout}),
               "parameters": sum(p.numel() for p in model.parameters()), "history": []}
@@ -112,12 +105,9 @@ def train_joint_network(train: list, holdout: list, *, epochs: int, learning_rat
             voters = attention.sum().clamp_min(1.0)
             balance = (len(attention) - voters) / voters
             attention_loss = torch.nn.functional.binary_cross_entropy_with_logits(
-                logits, attention, pos_weight=balance.clamp(1.0, 20.0))
+                logits, attention, pos_weight=balance.clamp(1.0, MAX_VOTER_WEIGHT))
             loss = offset_loss + ATTENTION_LOSS_WEIGHT * attention_loss
-            optimiser.zero_grad()
-            loss.backward()
-            optimiser.step()
-            schedule.step()
+            optimiser.step(loss)
             losses.append(loss.item())
         model.eval()
         weights = module_weights(model)
@@ -190,8 +180,7 @@ def train_connectivity_network(network: str, train: list, holdout: list, *, epoc
     loss_of = _bone_loss if network == "bones" else (lambda m, d, dev: _root_loss(m, d["roots"], dev))
     every = train_data["pair_features"] if network == "bones" else np.concatenate([f for f, _ in train_data["roots"]])
     model.standardise_from(torch.as_tensor(every, device=device))
-    optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate, weight_decay=WEIGHT_DECAY)
-    schedule = torch.optim.lr_scheduler.CosineAnnealingLR(optimiser, T_max=epochs)
+    optimiser = CosineAdam(model.parameters(), learning_rate, epochs)
     record = {"network": network, "seed": seed, "epochs": epochs, "learning_rate": learning_rate, "device": device,
               "train_examples": len(train), "holdout": sorted({e.name.split("#")[0] for e in holdout}),
               "parameters": sum(p.numel() for p in model.parameters()), "history": []}
@@ -200,10 +189,7 @@ def train_connectivity_network(network: str, train: list, holdout: list, *, epoc
     for epoch in range(1, epochs + 1):
         model.train()
         loss = loss_of(model, train_data, device)
-        optimiser.zero_grad()
-        loss.backward()
-        optimiser.step()
-        schedule.step()
+        optimiser.step(loss)
         model.eval()
         with torch.no_grad():
             held = float(loss_of(model, held_data, device))
@@ -219,8 +205,6 @@ def train_connectivity_network(network: str, train: list, holdout: list, *, epoc
 
 def connectivity_accuracy(network: str, weights: dict, data: dict) -> dict:
     """Held-out accuracy: bone pairs classified right, roots picked right."""
-    from ...rigging.connectivity import bone_probabilities, root_scores
-
     if network == "bones":
         predicted = bone_probabilities(weights, data["pair_features"]) > 0.5
         return {"holdout_accuracy": float(np.mean(predicted == (data["pair_labels"] > 0.5)))}

@@ -1,7 +1,7 @@
 """Training a skinning network from its examples (torch; never in Blender).
 
-One run: fixed seed, Adam with a cosine learning-rate schedule, one
-character per step. Each step turns the character by a random angle about
+One run: fixed seed, Adam with a cosine learning-rate schedule
+(:class:`.optimisation.CosineAdam`), one character per step. Each step turns the character by a random angle about
 the up axis and mirrors it left-right with probability one half
 (:func:`.augmentation.turn_and_mirror`), applied to the feature vectors
 (:data:`~autorig_addon.core.skinning.learned.features.VERTEX_VECTORS` and
@@ -34,10 +34,8 @@ from ...skinning.learned.networks import SCORE_FUNCTIONS, candidate_weights
 from ...skinning.learned.predict import dense_weights, finished_weights
 from .augmentation import turn_and_mirror, turned_columns
 from .export import module_weights
+from .optimisation import CosineAdam
 from .skin_networks import NETWORKS, graph_tensors
-
-#: Weight decay of Adam (a small network on few characters).
-WEIGHT_DECAY = 1e-5
 
 
 @dataclass
@@ -120,8 +118,7 @@ def train_network(network: str, train: list, holdout: list, *, epochs: int, seed
                             parameters=sum(parameter.numel() for parameter in model.parameters()))
     tensors = [(graph_tensors(graph, device), torch.as_tensor(target, device=device)) for _, graph, target in train]
     held = [(graph, reference) for _, graph, reference in holdout]
-    optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate, weight_decay=WEIGHT_DECAY)
-    schedule = torch.optim.lr_scheduler.CosineAnnealingLR(optimiser, T_max=epochs * len(tensors))
+    optimiser = CosineAdam(model.parameters(), learning_rate, epochs * len(tensors))
     best = module_weights(model)
     record.history.append({"epoch": 0, "loss": None, **holdout_scores(network, best, held)})
     record.best_epoch, record.best_l1 = 0, record.history[0]["l1"]
@@ -134,10 +131,7 @@ def train_network(network: str, train: list, holdout: list, *, epochs: int, seed
         for index in rng.permutation(len(tensors)):
             graph, target = tensors[index]
             loss = candidate_cross_entropy(model(augmented(graph, turn_and_mirror(rng))), target)
-            optimiser.zero_grad()
-            loss.backward()
-            optimiser.step()
-            schedule.step()
+            optimiser.step(loss)
             losses.append(loss.item())
         model.eval()
         weights = module_weights(model)
