@@ -57,7 +57,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "or core/rigging/trained/)")
     parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are (train skin)")
     parser.add_argument("--procedural", type=int, default=0,
-                        help="Also train on this many procedural characters (train skin; seeds 0 to N-1; default 0)")
+                        help="Also train on this many procedural characters (seeds 0 to N-1, exact skeletons; never held "
+                             "out; default 0)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -89,7 +90,7 @@ def _train_rig(args: argparse.Namespace, samples: Path) -> int:
 
     record = run_rig_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
                               learning_rate=args.learning_rate, seed=args.seed, device=args.device,
-                              output=args.output)
+                              output=args.output, procedural=args.procedural)
     print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out "
           f"{'CD-J2J' if args.model == 'joints' else 'loss'} {record['best_score']:.4f}, {record['seconds']:.0f} s "
           f"on {record['device']}", file=sys.stderr)

@@ -24,7 +24,7 @@ from ...nn.weights_io import save_weights
 from ...rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, NETWORK_NAMES, trained_weights_path
 from ...rigging.training_set import EXAMPLE_FORMAT_VERSION, TRAINING_SETTINGS, build_examples
 from .rig_training import train_connectivity_network, train_joint_network
-from .skin_run import HOLDOUT_EVERY, TRAINING_THREADS, pick_device
+from .skin_run import HOLDOUT_EVERY, TRAINING_THREADS, pick_device, procedural_samples
 
 
 def default_examples_dir(seed: int) -> Path:
@@ -33,8 +33,13 @@ def default_examples_dir(seed: int) -> Path:
 
 def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None,
                      epochs: Optional[int] = None, learning_rate: Optional[float] = None, seed: int = 0,
-                     device: str = "auto", output: Optional[Path] = None) -> dict:
-    """Train ``network`` (``joints``, ``bones`` or ``root``) and write its weights; returns the record."""
+                     device: str = "auto", output: Optional[Path] = None, procedural: int = 0) -> dict:
+    """Train ``network`` (``joints``, ``bones`` or ``root``) and write its weights; returns the record.
+
+    ``procedural`` adds the procedural characters of seeds ``0 .. procedural - 1``
+    (exact skeletons) as training characters; they are never held out, so
+    the epoch is still chosen on artists' rigs.
+    """
     if network not in NETWORK_NAMES:
         raise InputError(f"Unknown skeleton network '{network}': use one of {NETWORK_NAMES}.")
     torch.set_num_threads(TRAINING_THREADS)
@@ -46,7 +51,10 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
                               log=lambda line: print(line, file=sys.stderr, flush=True))
     names = sorted(examples)
     held_names = set(names[::HOLDOUT_EVERY])
+    made = build_examples(procedural_samples(procedural), Path(examples_dir or default_examples_dir(seed)), seed,
+                          log=lambda line: print(line, file=sys.stderr, flush=True))
     train = [example for name in names if name not in held_names for example in examples[name]]
+    train += [example for name in sorted(made) for example in made[name]]
     # Held-out characters are scored as they are, not on their stretched copies.
     holdout = [examples[name][0] for name in names if name in held_names]
     device = pick_device(device)
@@ -57,7 +65,7 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     else:
         weights, record = train_connectivity_network(network, train, holdout, epochs=epochs,
                                                      learning_rate=learning_rate, seed=seed, device=device)
-    record.update(torch_version=torch.__version__, python=sys.version.split()[0])
+    record.update(procedural=procedural, torch_version=torch.__version__, python=sys.version.split()[0])
     destination = Path(output) if output else trained_weights_path(network)
     destination.parent.mkdir(parents=True, exist_ok=True)
     save_weights(str(destination), weights, record)
