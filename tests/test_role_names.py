@@ -321,3 +321,42 @@ def test_legs_hanging_from_a_root_on_the_floor():
     assert [names[left] for left, _ in legs] == ["thigh.L", "shin.L", "foot.L"]
     assert [names[right] for _, right in arms] == ["upper_arm.R", "forearm.R", "hand.R"]
     assert [names[k] for k in controls] == ["limb.L", "limb.R"]
+
+
+def test_predicted_quadruped_with_a_branch_at_the_shoulders_and_hips_off_the_trunk():
+    # As the predictor gives them: the root mid-body, the hind legs hanging
+    # from a joint just behind it (their chains start far back), and a short
+    # pair of branches at the shoulders beside the front legs.
+    skeleton = Builder()
+    root = skeleton.add([0, -0.2, 0.6])
+    hips = skeleton.add([0, -0.3, 0.5], root)
+    chest = skeleton.add([0, -0.4, 0.6], root)
+    neck = skeleton.add([0, -0.5, 0.75], chest)
+    head = skeleton.add([0, -0.6, 0.8], neck)
+    tail = skeleton.add([0, 0.5, 0.6], root)
+    front = skeleton.add_pair_chain([(0.1, -0.4, 0.5), (0.1, -0.4, 0.25), (0.1, -0.42, 0.02)], chest)
+    hind = skeleton.add_pair_chain([(0.1, 0.35, 0.5), (0.1, 0.4, 0.25), (0.1, 0.35, 0.02)], hips)
+    branch = skeleton.add_pair([0.12, -0.45, 0.65], chest)
+    names = skeleton.names()
+    assert skeleton.kind() == QUADRUPED
+    assert [names[k] for k in (hips, root, chest, neck, head, tail)] == [
+        "spine", "spine.001", "spine.002", "neck", "head", "tail"]
+    assert [names[left] for left, _ in front] == ["front_thigh.L", "front_shin.L", "front_foot.L"]
+    assert [names[right] for _, right in hind] == ["thigh.R", "shin.R", "foot.R"]
+    assert [names[k] for k in branch] == ["limb.L", "limb.R"]
+
+
+def test_predicted_biped_with_its_root_above_the_hips():
+    # The predictor's root may be a belly joint the hips hang below and the spine rises from.
+    skeleton = Builder()
+    root = skeleton.add([0, 0, 0.6])
+    hips = skeleton.add([0, 0, 0.5], root)
+    chest = skeleton.add([0, 0, 0.75], root)
+    head = skeleton.add([0, 0, 0.9], chest)
+    legs = skeleton.add_pair_chain([(0.1, 0, 0.5), (0.1, 0, 0.27), (0.1, 0, 0.04)], hips)
+    arms = skeleton.add_pair_chain([(0.15, 0, 0.8), (0.32, 0, 0.8), (0.48, 0, 0.8)], chest)
+    names = skeleton.names()
+    assert skeleton.kind() == BIPED
+    assert [names[k] for k in (hips, root, chest, head)] == ["spine", "spine.001", "spine.002", "head"]
+    assert [names[left] for left, _ in legs] == ["thigh.L", "shin.L", "foot.L"]
+    assert [names[right] for _, right in arms] == ["upper_arm.R", "forearm.R", "hand.R"]

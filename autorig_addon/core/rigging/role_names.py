@@ -83,6 +83,10 @@ QUADRUPED_LEVEL_RATIO = 1.0
 #: lies closer to the midline than this share of the chain's sideways reach.
 #: Rigify's human puts it at 3 % and the upper arm at 27 %.
 CLAVICLE_LATERAL_SHARE = 0.2
+#: A biped's arms may hang from a midline side branch off the trunk of at
+#: most this many joints (the predictor finds such short branches at the
+#: shoulders); counted in joints.
+ARM_BRANCH_JOINTS = 2
 #: Joints an arm has before its hand (upper arm and forearm): a chain
 #: branching earlier is not branching at the hand.
 JOINTS_BEFORE_HAND = 2
@@ -159,12 +163,14 @@ def classify_body(joints, parents, mirror) -> str:
 
     A leg is a mirrored limb that starts above the ground and reaches it
     (:data:`GROUND_SHARE`). A biped has one pair of legs hanging from a
-    midline joint (the hips, or a root on the floor), a midline path from the hips rising
-    upright to the top (spine, neck, head) and a mirrored pair of limbs
-    hanging from that path above the hips (the arms; they may reach the
-    ground too). A quadruped has exactly two pairs of legs hanging from
-    midline joints set apart along a level body; the pair
-    further toward -Y is the front legs.
+    midline joint (the hips, or a root on the floor), a midline path from the
+    hips rising upright to the top (spine, neck, head; it may run up through a
+    root above the hips) and a mirrored pair of limbs hanging from that path
+    above the hips, or from a short midline branch off it (the arms; they may
+    reach the ground too). A quadruped has exactly two pairs of legs hanging
+    from midline joints set apart along a level body (where they hang from or
+    where they start); the pair further toward -Y is the front legs. Short
+    extra branches elsewhere do not matter: predicted skeletons have them.
 
     Parameters
     ----------
@@ -323,7 +329,7 @@ def _spine_with_ancestors(frame: _Frame, path: list, roles: dict) -> list:
     becomes ``root``."""
     above = []
     for joint in frame.ancestors(path[0])[1:]:
-        if frame.side[joint] != _MIDLINE:
+        if frame.side[joint] != _MIDLINE or joint in path:
             break
         above.append(joint)
     trunk = above[::-1] + path
@@ -352,20 +358,26 @@ def _biped_roles(frame: _Frame, limbs: list, grounded: list):
     hips = leg.attach
     if not _on_midline(frame, hips):
         return None
-    trunk = frame.midline_below(hips)
+    # The whole midline part holding the hips: a predicted root may lie above them.
+    trunk = frame.midline_below(_midline_top(frame, hips))
     path = frame.path_between(hips, _head_top(frame, trunk))
     top = path[-1]
-    rise = frame.joints[top, 2] - frame.joints[hips, 2]
-    run = abs(frame.joints[top, 1] - frame.joints[hips, 1])
+    # From where the legs start, when the predictor hangs them from a joint above that.
+    rise = frame.joints[top, 2] - min(frame.joints[hips, 2], frame.joints[leg.root, 2])
+    # Front-to-back travel along the whole way, not end to end: the way may
+    # go forward along a level body and up a fin.
+    run = np.abs(np.diff(frame.joints[path, 1])).sum()
     if rise < BIPED_MIN_RISE_SHARE * frame.height or rise < BIPED_UPRIGHT_RATIO * run:
         return None
-    above_hips = {joint: position for position, joint in enumerate(path) if position > 0}
-    arms = [limb for limb in limbs if limb is not leg and limb.attach in above_hips]
+    on_path = {joint: position for position, joint in enumerate(path)}
+    arms = [(limb, _path_position(frame, limb, on_path)) for limb in limbs if limb is not leg]
+    # Arms hanging from the hips joint itself (a predicted root there) start well above the legs.
+    arms = [(limb, position) for limb, position in arms if position is not None and (
+        position > 0 or frame.joints[limb.root, 2] - frame.joints[leg.root, 2] >= BIPED_MIN_RISE_SHARE * frame.height)]
     if not arms:
         return None
-    arm = max(arms, key=lambda limb: (limb.length, -limb.root))
+    arm, shoulders = max(arms, key=lambda item: (item[0].length, -item[0].root))
     roles: dict = {}
-    shoulders = above_hips[arm.attach]
     spine = _spine_with_ancestors(frame, path[:shoulders + 1], roles)
     _assign(roles, spine, chain_names(SPINE, len(spine)))
     _head_and_neck(roles, path[shoulders + 1:])
@@ -374,14 +386,43 @@ def _biped_roles(frame: _Frame, limbs: list, grounded: list):
     return roles
 
 
+def _midline_top(frame: _Frame, joint: int) -> int:
+    """The highest ancestor in the tree reached from ``joint`` through midline joints."""
+    for above in frame.ancestors(joint)[1:]:
+        if frame.side[above] != _MIDLINE:
+            break
+        joint = above
+    return joint
+
+
+def _path_position(frame: _Frame, limb: _Limb, on_path: dict):
+    """Index in a biped's trunk path of the joint an arm hangs from: its
+    attachment, or the nearest trunk joint above it when it hangs from a short
+    midline side branch (:data:`ARM_BRANCH_JOINTS` joints at most) off the
+    trunk above the hips; None for neither."""
+    if not _on_midline(frame, limb.attach):
+        return None
+    for steps, joint in enumerate(frame.ancestors(limb.attach)[:ARM_BRANCH_JOINTS + 1]):
+        if frame.side[joint] != _MIDLINE:
+            return None
+        if joint in on_path:
+            # A branch off the hips themselves is no shoulder (a fish's eyes
+            # on its head, its fins at its middle).
+            return on_path[joint] if steps == 0 or on_path[joint] > 0 else None
+    return None
+
+
 def _head_top(frame: _Frame, trunk: list) -> int:
     """The top of a biped's trunk: its highest midline joint, or the joint
-    below it when that one starts a chain hanging backward and down (hair,
-    a ponytail; a jaw hangs forward and stays below the head)."""
+    below it when that one starts a chain hanging backward and down with no
+    limbs on it (hair, a ponytail; a jaw hangs forward and stays below the
+    head)."""
     top = max(trunk, key=lambda joint: (frame.joints[joint, 2], -joint))
     hanging = frame.main_path(top)
     run = frame.joints[hanging[-1]] - frame.joints[top]
-    if len(hanging) > 1 and run[1] > 0 and run[2] < 0 and top != trunk[0]:
+    # Hair carries no mirrored limbs; a short branch the arms hang from is no hair.
+    carries_limbs = any(frame.side[c] != _MIDLINE for joint in hanging for c in frame.children[joint])
+    if len(hanging) > 1 and run[1] > 0 and run[2] < 0 and top != trunk[0] and not carries_limbs:
         return int(frame.parents[top])
     return top
 
@@ -390,7 +431,10 @@ def _quadruped_roles(frame: _Frame, grounded: list):
     if len(grounded) != 2 or not all(_on_midline(frame, limb.attach) for limb in grounded):
         return None
     front, hind = sorted(grounded, key=lambda limb: (frame.joints[limb.attach, 1], frame.joints[limb.root, 1], limb.root))
-    along = frame.joints[hind.attach, 1] - frame.joints[front.attach, 1]
+    # The predictor may hang a pair of legs from a midline joint off the
+    # trunk, short of where the legs start: legs set apart at either end count.
+    along = max(frame.joints[hind.attach, 1] - frame.joints[front.attach, 1],
+                frame.joints[hind.root, 1] - frame.joints[front.root, 1])
     rise = abs(frame.joints[front.attach, 2] - frame.joints[hind.attach, 2])
     if along < QUADRUPED_MIN_LEG_SPACING * frame.size or along < QUADRUPED_LEVEL_RATIO * rise:
         return None
