@@ -88,3 +88,39 @@ def test_batches_and_empty_queries(monkeypatch):
         np.testing.assert_array_equal(getattr(batched, name), getattr(whole, name))
     empty = query.closest(np.zeros((0, 3)))
     assert empty.points.shape == (0, 3) and empty.distances.shape == (0,) and empty.triangles.dtype == np.int64
+
+
+def brute_force_distances(mesh, P):
+    F = mesh.triangles
+    q, m = len(P), len(F)
+    points, _ = closest_points_on_triangles(
+        np.repeat(P, m, axis=0), *(np.tile(mesh.vertices[F[:, k]], (q, 1)) for k in range(3)))
+    return np.linalg.norm(points - np.repeat(P, m, axis=0), axis=1).reshape(q, m).min(axis=1)
+
+
+def test_a_triangle_soup_finds_the_same_closest_points():
+    # Every triangle with its own corners, as some exporters write a body:
+    # candidates found twice (by centroid and by corner) are tested once.
+    mesh = cylinder(radius=0.2, segments=12, rings=6)
+    soup = mesh.vertices[mesh.triangles.ravel()]
+    soup_triangles = np.arange(len(soup)).reshape(-1, 3)
+    query = TriangleMeshQuery(soup, soup_triangles)
+    P = np.random.default_rng(5).uniform(-0.5, 1.5, size=(300, 3))
+    result = query.closest(P)
+    np.testing.assert_allclose(result.distances, brute_force_distances(mesh, P), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(result.points - P, axis=1), result.distances, atol=1e-12)
+
+
+def test_surely_farther_never_rules_out_a_point_within_the_distance():
+    mesh = cylinder(radius=0.2, segments=12, rings=6)
+    query = TriangleMeshQuery(mesh.vertices, mesh.triangles)
+    P = np.random.default_rng(6).uniform(-3.0, 4.0, size=(2000, 3))
+    exact = brute_force_distances(mesh, P)
+    limits = np.where(np.arange(len(P)) % 2 == 0, 0.3, 1.0)  # two distances, as the unit check queries
+    farther = query.surely_farther(P, limits)
+    assert not (farther & (exact <= limits)).any()
+    # It is a useful test: points far beyond the longest edge are ruled out.
+    longest = max(np.linalg.norm(mesh.vertices[mesh.triangles[:, k]] - mesh.vertices[mesh.triangles[:, (k + 1) % 3]],
+                                 axis=1).max() for k in range(3))
+    clearly = exact > limits + 2 * longest
+    assert clearly.sum() > 500 and farther[clearly].all()

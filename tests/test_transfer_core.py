@@ -18,7 +18,7 @@ from autorig_addon.core.errors import InputError
 from autorig_addon.core.geometry import sparse_solve
 from autorig_addon.core.geometry.laplacian import cotangent_laplacian, voronoi_mass
 from autorig_addon.core.geometry.smoothing import smooth_over_surface
-from autorig_addon.core.transfer import TransferOptions, VertexStatus, transfer_weights
+from autorig_addon.core.transfer import TransferOptions, TransferSource, VertexStatus, transfer_weights
 from autorig_addon.core.transfer.inpainting import inpaint_weights, inpainting_operator
 from autorig_addon.core.transfer.matching import closest_point_weights, match_closest_points
 from autorig_addon.core.types import Mesh, Weights
@@ -227,6 +227,24 @@ def test_unusable_inputs_are_refused_with_their_message(body):
         transfer_weights(source, corrupt, target)
 
 
+def test_a_source_prepared_once_serves_many_targets_with_the_same_weights(body):
+    source, two_bones = body
+    # A third bone that weighs nothing on the body stays an empty column.
+    weights = Weights(np.column_stack([two_bones.matrix, np.zeros(source.vertex_count)]), ["lower", "upper", "unused"])
+    prepared_body = TransferSource.prepare(source, weights)
+    for target in (sleeve(), sleeve(z0=-0.4, height=1.0, rings=41)):
+        alone = transfer_weights(source, weights, target)
+        reused = transfer_weights(source, weights, target, prepared=prepared_body)
+        np.testing.assert_array_equal(reused.weights.matrix, alone.weights.matrix)
+        np.testing.assert_array_equal(reused.status, alone.status)
+        assert reused.weights.bone_names == ("lower", "upper", "unused")
+        np.testing.assert_array_equal(reused.weights.matrix[:, 2], 0.0)
+        np.testing.assert_allclose(reused.weights.matrix.sum(axis=1), 1.0, atol=1e-12)
+    other = Weights(weights.matrix.copy(), weights.bone_names)
+    with pytest.raises(ValueError, match="another mesh or weights"):
+        transfer_weights(source, other, sleeve(), prepared=prepared_body)
+
+
 def test_inpainting_reproduces_linear_function_on_a_flat_grid():
     # -L and L M^-1 L both vanish on linear functions in the interior, so a
     # linear field fixed on a band at the boundary is recovered inside.
@@ -286,18 +304,22 @@ def test_overlap_check_honours_a_larger_match_distance(body):
     np.testing.assert_allclose(result.weights.matrix[near, 1], expected_upper(z[near]), atol=1e-12)
 
 
+def prepared(mesh, matrix):
+    return TransferSource.prepare(mesh, Weights(matrix, [f"bone{i}" for i in range(matrix.shape[1])]))
+
+
 def test_matching_copies_near_points_and_flags_opposite_normals():
     # A unit square at z = 0 facing +z, weights ramping along x; targets above and below it.
     square = grid(2, 2)
     source_weights = np.column_stack([1 - square.vertices[:, 0], square.vertices[:, 0]])
     target = Mesh([[0.25, 0.5, 0.1], [0.75, 0.5, -0.1], [0.5, 0.5, 0.3], [0.5, 0.5, 0.1]], [[0, 1, 2]])
     normals = np.array([[0, 0, 1.0], [0, 0, -1.0], [0, 0, 1.0], [np.sin(0.6), 0, np.cos(0.6)]])  # last: 34 degrees off
-    matches = match_closest_points(square, source_weights, target, normals, 0.2, 30.0, True)
+    matches = match_closest_points(prepared(square, source_weights), target, normals, 0.2, 30.0, True)
     np.testing.assert_allclose(matches.weights, [[0.75, 0.25], [0.25, 0.75], [0.5, 0.5], [0.5, 0.5]], atol=1e-12)
     np.testing.assert_allclose(matches.distances, [0.1, 0.1, 0.3, 0.1], atol=1e-12)
     np.testing.assert_array_equal(matches.matched, [True, True, False, False])  # too far; normal too far off
     np.testing.assert_array_equal(matches.flipped, [False, True, False, False])
-    strict = match_closest_points(square, source_weights, target, normals, 0.2, 30.0, False)
+    strict = match_closest_points(prepared(square, source_weights), target, normals, 0.2, 30.0, False)
     np.testing.assert_array_equal(strict.matched, [True, False, False, False])
     assert not strict.flipped.any()
 
@@ -447,7 +469,7 @@ def test_matching_falls_back_to_the_nearest_weighted_vertex_where_the_closest_po
     source_weights[square.vertices[:, 0] > 0.9] = np.nan  # the x = 1 column is corrupt
     target = Mesh([[0.25, 0.5, 0.05], [0.9, 0.5, 0.05], [0.5, 0.4, 0.05]], [[0, 1, 2]])
     normals = np.tile([0.0, 0.0, 1.0], (3, 1))
-    matches = match_closest_points(square, source_weights, target, normals, 0.2, 30.0, True)
+    matches = match_closest_points(prepared(square, source_weights), target, normals, 0.2, 30.0, True)
     np.testing.assert_array_equal(matches.matched, [True, False, True])
     np.testing.assert_array_equal(matches.unweighted, [False, True, False])
     # Vertex 1 draws on the corrupt column: it takes the nearest usable vertex's (x = 0.5) weights.

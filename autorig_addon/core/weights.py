@@ -61,7 +61,9 @@ def usable_rows(weights: np.ndarray) -> np.ndarray:
     [True, False, False, False]
     """
     weights = np.asarray(weights, dtype=np.float64)
-    return ~invalid_rows(weights) & ~empty_rows(np.nan_to_num(weights))
+    # NaN compares False, so empty_rows needs no cleaning: a row with NaN is invalid anyway.
+    with np.errstate(invalid="ignore"):
+        return ~invalid_rows(weights) & ~empty_rows(weights)
 
 
 def limit_influences(weights: np.ndarray, max_influences: int) -> np.ndarray:

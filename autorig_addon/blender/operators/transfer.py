@@ -36,7 +36,8 @@ from ...core.transfer.combine import (
 from ...core.transfer.options import GROUP_MEMBER_THRESHOLD, TransferOptions
 from ...core.messages import listed_names
 from ...core.geometry.outliers import require_finite_positions, rows_for_strays
-from ...core.transfer.transfer import VertexStatus, check_source_weights, transfer_weights
+from ...core.transfer.source import TransferSource
+from ...core.transfer.transfer import VertexStatus, transfer_weights
 from ...core.types import Mesh, Weights
 from ...core.weights import normalize_rows
 from .. import convert
@@ -91,8 +92,9 @@ class TransferPlan:
     armature : bpy.types.Object (armature deforming the source)
     bone_names : tuple of b str, the source's deform bones, column order
     transferred_bones : tuple of str, the subset whose weights are written
-    source_mesh : Mesh, without far stray vertices (``core.geometry.outliers``)
-    source_weights : Weights (n_source, b), raw as stored (the core skips unusable rows)
+    source_data : TransferSource, the source's mesh without far stray vertices
+        (``core.geometry.outliers``) and its weights raw as stored (the core
+        skips unusable rows), checked and indexed once for every target
     settings : TransferSettings
     rigid : list of RigidBinding, props on a bone bound wholly to it instead
     left_rigid : list of bpy.types.Object, props on a bone left as they are
@@ -105,8 +107,7 @@ class TransferPlan:
     armature: object
     bone_names: tuple
     transferred_bones: tuple
-    source_mesh: Mesh
-    source_weights: Weights
+    source_data: TransferSource
     settings: TransferSettings
     rigid: list = field(default_factory=list)
     left_rigid: list = field(default_factory=list)
@@ -313,7 +314,7 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
                          f"{'its bone' if one else 'their bones'}. Name the meshes to weight them.")
     source_weights = convert.read_weights(source, bone_names)
     # NaN weights (which vertex groups can hold) are not a naming problem:
-    # the core's check_source_weights says what is wrong with them.
+    # the core's TransferSource.prepare says what is wrong with them.
     if not np.any(source_weights.matrix > 0) and not np.isnan(source_weights.matrix).any():
         raise InputError(
             f"'{source.name}' has no weights for the deform bones of '{armature.name}': "
@@ -321,7 +322,6 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
         )
     source_mesh = convert.read_mesh([source], depsgraph)
     require_finite_positions(source_mesh.vertices, source_mesh.object_names, source_mesh.object_offsets)
-    check_source_weights(source_mesh, source_weights)
     kept_source, source_strays = split_strays(source_mesh)
     notes = {obj: [note] for obj, note in shared_mesh_notes(targets + [b.obj for b in rigid]).items()}
     if source_strays is not None:
@@ -336,9 +336,8 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
         armature=armature,
         bone_names=bone_names,
         transferred_bones=_transferred_bones(settings, bone_names, armature),
-        source_mesh=source_mesh,
-        # Raw: the core never copies rows without usable weights (none, NaN) and reports them.
-        source_weights=source_weights,
+        # Raw weights: the core never copies rows without usable weights (none, NaN) and reports them.
+        source_data=TransferSource.prepare(source_mesh, source_weights),
         settings=settings,
         rigid=rigid,
         left_rigid=left_rigid,
@@ -359,14 +358,15 @@ def _transfer_without_strays(plan: TransferPlan, target_mesh: Mesh, inpaint_mask
         return None if mask is None else mask[keep]
 
     result = transfer_weights(
-        plan.source_mesh,
-        plan.source_weights,
+        plan.source_data.mesh,
+        plan.source_data.weights,
         kept_mesh,
         plan.settings.options,
         inpaint_mask=subset(inpaint_mask),
         protected=subset(protected),
         protected_weights=Weights(existing.matrix[keep], existing.bone_names) if protected is not None else None,
         progress=progress,
+        prepared=plan.source_data,
     )
     same_order = result.weights.bone_names == plan.bone_names
     incoming = result.weights.matrix if same_order else result.weights.select_bones(plan.bone_names).matrix

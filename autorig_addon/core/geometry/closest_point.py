@@ -121,8 +121,32 @@ class TriangleMeshQuery:
         used = np.unique(self.F)
         self._used_vertices = used
         self._vertex_tree = cKDTree(self.V[used])
-        self._centroid_tree = cKDTree(self.V[self.F].mean(axis=1))
+        corners = self.V[self.F]
+        centroids = corners.mean(axis=1)
+        self._centroids = centroids
+        self._centroid_tree = cKDTree(centroids)
+        # No point of a triangle lies farther from its centroid than its farthest corner.
+        self._radii = np.sqrt(((corners - centroids[:, None]) ** 2).sum(axis=2).max(axis=1))
         self._vertex_triangles = _vertex_triangle_table(self.F, len(self.V))
+        # Every surface point lies within its triangle's longest edge of a corner.
+        self._longest_edge = float(np.sqrt(max(((corners - np.roll(corners, 1, axis=1)) ** 2).sum(axis=2).max(), 0.0)))
+
+    def surely_farther(self, P: np.ndarray, distances) -> np.ndarray:
+        """(q,) bool: points of ``P`` (q, 3) certainly farther than
+        ``distances`` (a float or (q,) array) from the surface, from their
+        nearest vertex alone: a cheap test that spares the exact one for
+        points far from the mesh."""
+        P = np.asarray(P, dtype=np.float64).reshape(-1, 3)
+        distances = np.broadcast_to(np.asarray(distances, dtype=np.float64), (len(P),))
+        farther = np.ones(len(P), dtype=bool)
+        # The search stops at the bound (a far query otherwise visits much of
+        # the tree), so points sharing a distance are queried together.
+        for distance in np.unique(distances):
+            rows = np.flatnonzero(distances == distance)
+            bound = distance + self._longest_edge
+            nearest, _ = self._vertex_tree.query(P[rows], distance_upper_bound=bound * (1 + 1e-9))
+            farther[rows] = nearest > bound
+        return farther
 
     def closest(self, P: np.ndarray) -> SurfacePoints:
         """Closest surface point for each row of ``P`` (q, 3)."""
@@ -137,23 +161,34 @@ class TriangleMeshQuery:
         q = len(P)
         k_v = min(NEAREST_VERTEX_CANDIDATES, len(self._used_vertices))
         k_c = min(NEAREST_CENTROID_CANDIDATES, len(self.F))
-        _, vi = self._vertex_tree.query(P, k=k_v)
+        vd, vi = self._vertex_tree.query(P, k=k_v)
         _, ci = self._centroid_tree.query(P, k=k_c)
+        vd = np.asarray(vd).reshape(q, k_v)
         vi = self._used_vertices[np.asarray(vi).reshape(q, k_v)]
         ci = np.asarray(ci).reshape(q, k_c)
         around = self._vertex_triangles[vi].reshape(q, -1)  # -1 pads
-        candidates = np.concatenate([ci, around], axis=1)
-        valid = candidates >= 0
-        candidates = np.where(valid, candidates, ci[:, :1])
-        flat = candidates.ravel()
-        tri = self.F[flat]
-        Pq = np.repeat(P, candidates.shape[1], axis=0)
-        points, bary = closest_points_on_triangles(Pq, self.V[tri[:, 0]], self.V[tri[:, 1]], self.V[tri[:, 2]])
-        d2 = np.sum((points - Pq) ** 2, axis=1).reshape(q, -1)
-        best = d2.argmin(axis=1)
-        rows = np.arange(q)
-        pick = rows * candidates.shape[1] + best
-        return SurfacePoints(points[pick], np.sqrt(d2[rows, best]), flat[pick], bary[pick])
+        # Sorted, so a triangle found both ways is tested once.
+        candidates = np.sort(np.concatenate([ci, around], axis=1), axis=1)
+        fresh = np.ones(candidates.shape, dtype=bool)
+        fresh[:, 1:] = candidates[:, 1:] != candidates[:, :-1]
+        # The nearest vertex lies on the surface, so the closest point is no
+        # farther; a triangle whose centroid is farther than that plus its
+        # radius cannot hold it. Both cuts leave the exact test fewer
+        # candidates with the same answer.
+        safe = np.maximum(candidates, 0)
+        lower = np.linalg.norm(self._centroids[safe] - P[:, None], axis=2) - self._radii[safe]
+        keep = fresh & (candidates >= 0) & (lower <= vd[:, :1] * (1 + 1e-9) + 1e-12)
+        rows, slots = np.nonzero(keep)  # row-major: rows ascending, each query's candidates together
+        triangles = candidates[rows, slots]
+        tri = self.F[triangles]
+        points, bary = closest_points_on_triangles(P[rows], self.V[tri[:, 0]], self.V[tri[:, 1]], self.V[tri[:, 2]])
+        d2 = np.sum((points - P[rows]) ** 2, axis=1)
+        starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
+        nearest = np.minimum.reduceat(d2, starts)
+        # Per query, its first candidate at the least distance.
+        hits = np.flatnonzero(d2 == nearest[rows])
+        first = hits[np.r_[True, rows[hits][1:] != rows[hits][:-1]]]
+        return SurfacePoints(points[first], np.sqrt(d2[first]), triangles[first], bary[first])
 
 
 def _vertex_triangle_table(F: np.ndarray, n: int) -> np.ndarray:

@@ -8,6 +8,8 @@ sparse results are ``scipy.sparse.csr_matrix``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -35,7 +37,7 @@ def corner_cotangents(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return cot
 
 
-def cotangent_laplacian(V: np.ndarray, F: np.ndarray) -> sp.csr_matrix:
+def cotangent_laplacian(V: np.ndarray, F: np.ndarray, cot: np.ndarray | None = None) -> sp.csr_matrix:
     """Cotangent Laplacian ``L`` (n, n), negative semi-definite.
 
     ``L[i, j] = (cot a_ij + cot b_ij) / 2`` for each edge, diagonal minus the
@@ -46,31 +48,37 @@ def cotangent_laplacian(V: np.ndarray, F: np.ndarray) -> sp.csr_matrix:
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int array
+    cot : (m, 3) float64 array, :func:`corner_cotangents` when the caller has them
 
     Returns
     -------
     L : (n, n) scipy.sparse.csr_matrix, symmetric
     """
     n = len(V)
-    cot = corner_cotangents(V, F)
+    cot = corner_cotangents(V, F) if cot is None else cot
     # The angle at corner k is opposite the edge between corners k+1 and k+2.
     rows = np.concatenate([F[:, (k + 1) % 3] for k in range(3)])
     cols = np.concatenate([F[:, (k + 2) % 3] for k in range(3)])
     values = 0.5 * np.concatenate([cot[:, k] for k in range(3)])
-    off = sp.coo_matrix((values, (rows, cols)), shape=(n, n))
-    off = (off + off.T).tocsr()
-    return (off - sp.diags(np.asarray(off.sum(axis=1)).ravel())).tocsr()
+    diagonal = -(np.bincount(rows, weights=values, minlength=n) + np.bincount(cols, weights=values, minlength=n))
+    every = np.arange(n)
+    # One conversion sums the duplicate entries of shared edges.
+    return sp.coo_matrix(
+        (np.concatenate([values, values, diagonal]),
+         (np.concatenate([rows, cols, every]), np.concatenate([cols, rows, every]))),
+        shape=(n, n),
+    ).tocsr()
 
 
-def voronoi_mass(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+def voronoi_mass(V: np.ndarray, F: np.ndarray, cot: np.ndarray | None = None) -> np.ndarray:
     """(n,) float64 lumped mass: each vertex's mixed Voronoi area (Meyer et al. 2003).
 
     Obtuse triangles give half their area to the obtuse corner and a quarter
     to the others. Vertices in no triangle get zero. The masses sum to the
-    surface area.
+    surface area. ``cot``: :func:`corner_cotangents`, when the caller has them.
     """
     area = 0.5 * triangle_double_areas(V, F)
-    cot = corner_cotangents(V, F)
+    cot = corner_cotangents(V, F) if cot is None else cot
     corner_area = np.zeros((len(F), 3))
     for k in range(3):
         e_next = np.sum((V[F[:, (k + 2) % 3]] - V[F[:, k]]) ** 2, axis=1)  # edge k -> k+2
@@ -83,7 +91,31 @@ def voronoi_mass(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     # Degenerate triangles: split their (tiny) area evenly, never negative.
     bad = ~np.isfinite(corner_area).all(axis=1) | (corner_area < 0).any(axis=1)
     corner_area[bad] = area[bad, None] / 3.0
-    mass = np.zeros(len(V))
-    for k in range(3):
-        np.add.at(mass, F[:, k], corner_area[:, k])
-    return mass
+    return np.bincount(F.ravel(), weights=corner_area.ravel(), minlength=len(V))
+
+
+@dataclass(frozen=True)
+class SurfaceOperators:
+    """The cotangent Laplacian and the lumped mass of one mesh, built
+    together (:func:`surface_operators`) for callers that need both at
+    several scales: the Laplacian does not change with scale, the mass grows
+    with its square.
+
+    Attributes
+    ----------
+    laplacian : (n, n) scipy.sparse.csr_matrix (:func:`cotangent_laplacian`)
+    mass : (n,) float64 array (:func:`voronoi_mass`), at the mesh's own scale
+    """
+
+    laplacian: sp.csr_matrix
+    mass: np.ndarray
+
+    def mass_scaled(self, factor: float) -> np.ndarray:
+        """The mass of the mesh scaled by ``factor`` (> 0)."""
+        return self.mass * (factor * factor)
+
+
+def surface_operators(V: np.ndarray, F: np.ndarray) -> SurfaceOperators:
+    """:class:`SurfaceOperators` of the mesh ``(V, F)``, its cotangents computed once."""
+    cot = corner_cotangents(V, F)
+    return SurfaceOperators(cotangent_laplacian(V, F, cot), voronoi_mass(V, F, cot))

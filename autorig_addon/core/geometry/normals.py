@@ -37,8 +37,7 @@ def triangle_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
 
 def vertex_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """(n, 3) float64 area-weighted unit vertex normals (zero where no face)."""
-    area_normals = triangle_area_normals(V, F)
-    normals = np.zeros((len(V), 3))
-    for corner in range(3):
-        np.add.at(normals, F[:, corner], area_normals)
+    area_normals = np.repeat(triangle_area_normals(V, F), 3, axis=0)  # one row per corner, as F.ravel()
+    corners = np.asarray(F).ravel()
+    normals = np.stack([np.bincount(corners, weights=area_normals[:, k], minlength=len(V)) for k in range(3)], axis=1)
     return _unit_rows(normals)

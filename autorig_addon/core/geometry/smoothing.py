@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .laplacian import cotangent_laplacian, voronoi_mass
+from .laplacian import SurfaceOperators, surface_operators
 from .sparse_solve import solve_positive_definite
 from .topology import adjacency_matrix
 
@@ -60,7 +60,7 @@ def smooth_over_edges(values: np.ndarray, F: np.ndarray, iterations: int, streng
 
 
 def smooth_over_surface(values: np.ndarray, V: np.ndarray, F: np.ndarray, length: float,
-                        fixed: np.ndarray | None = None) -> np.ndarray:
+                        fixed: np.ndarray | None = None, operators: SurfaceOperators | None = None) -> np.ndarray:
     """Heat smoothing of per-vertex ``values`` over the surface, at a length scale.
 
     One implicit (backward Euler) step of the heat equation for the time
@@ -82,6 +82,7 @@ def smooth_over_surface(values: np.ndarray, V: np.ndarray, F: np.ndarray, length
     F : (m, 3) int array
     length : float >= 0, scene units; 0 returns a copy of ``values``
     fixed : (n,) bool array or None
+    operators : SurfaceOperators of ``(V, F)`` when the caller has them
 
     Returns
     -------
@@ -90,10 +91,10 @@ def smooth_over_surface(values: np.ndarray, V: np.ndarray, F: np.ndarray, length
     smoothed = np.array(values, dtype=np.float64, copy=True)
     if not length > 0 or not len(F) or not smoothed.size:
         return smoothed
+    operators = surface_operators(np.asarray(V, dtype=np.float64), F) if operators is None else operators
     # In units of ``length`` the system is (M - L) X = M X0, scaled near one
     # whatever the scene units.
-    scaled = np.asarray(V, dtype=np.float64) / length
-    mass = voronoi_mass(scaled, F)
+    mass = operators.mass_scaled(1.0 / length)
     free = mass > 0
     if fixed is not None:
         free &= ~np.asarray(fixed, dtype=bool)
@@ -101,7 +102,7 @@ def smooth_over_surface(values: np.ndarray, V: np.ndarray, F: np.ndarray, length
     active = np.flatnonzero(np.any(smoothed != 0, axis=0))
     if not free.any() or not len(active):
         return smoothed
-    laplacian = cotangent_laplacian(scaled, F)
+    laplacian = operators.laplacian
     inside, boundary = np.flatnonzero(free), np.flatnonzero(~free)
     system = (sp.diags(mass[inside]) - laplacian[inside][:, inside]).tocsc()
     rhs = mass[inside, None] * smoothed[np.ix_(inside, active)]

@@ -39,14 +39,33 @@ def weld_vertices(V: np.ndarray, F: np.ndarray, tolerance: float) -> tuple[np.nd
     welded_F : (m', 3) int64 array, triangles that collapsed dropped
     to_welded : (n,) int64 array mapping each original vertex to its welded one
     """
-    pairs = cKDTree(V).query_pairs(r=tolerance, output_type="ndarray") if len(V) else np.zeros((0, 2), int)
+    V = np.asarray(V, dtype=np.float64)
     n = len(V)
-    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, to_welded = connected_components(graph, directed=False)
-    count = to_welded.max() + 1 if n else 0
-    welded_V = np.zeros((count, 3))
-    np.add.at(welded_V, to_welded, V)
-    welded_V /= np.maximum(np.bincount(to_welded, minlength=count), 1)[:, None]
+    if not n:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    # Most copies sit at exactly the same place: joining those by sorting
+    # first leaves the neighbour search a fraction of the points.
+    order = np.lexsort(V.T[::-1])
+    ordered = V[order]
+    new_place = np.ones(n, dtype=bool)
+    new_place[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    to_place = np.empty(n, dtype=np.int64)
+    to_place[order] = np.cumsum(new_place) - 1
+    places = ordered[new_place]
+    pairs = cKDTree(places).query_pairs(r=tolerance, output_type="ndarray")
+    m = len(places)
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(m, m))
+    _, place_group = connected_components(graph, directed=False)
+    groups = place_group[to_place]
+    # Numbered by first appearance, as the vertices are ordered.
+    _, first = np.unique(groups, return_index=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+    to_welded = rank[groups]
+    count = len(first)
+    copies = np.maximum(np.bincount(to_welded, minlength=count), 1)
+    welded_V = np.stack([np.bincount(to_welded, weights=V[:, k], minlength=count) for k in range(3)], axis=1)
+    welded_V /= copies[:, None]
     welded_F = to_welded[F]
     keep = (welded_F[:, 0] != welded_F[:, 1]) & (welded_F[:, 1] != welded_F[:, 2]) & (welded_F[:, 2] != welded_F[:, 0])
     return welded_V, welded_F[keep].astype(np.int64), to_welded.astype(np.int64)

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from ..geometry.laplacian import cotangent_laplacian, voronoi_mass
+from ..geometry.laplacian import surface_operators
 from ..geometry.topology import connected_component_labels
 from ..geometry.weld import weld_mesh
 from ..types import Mesh
@@ -62,8 +62,8 @@ def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, he
     sources = relative <= nearest[:, None] * (1.0 + NEAREST_TIE_FRACTION)
     sources = sources / sources.sum(axis=1, keepdims=True)
     unit_V = welded.vertices / diagonal
-    mass = voronoi_mass(unit_V, welded_F)
-    mass = np.maximum(mass, LOOSE_VERTEX_MASS_FRACTION * max(mass.max(initial=0.0), 1e-300))
+    operators = surface_operators(unit_V, welded_F)
+    mass = np.maximum(operators.mass, LOOSE_VERTEX_MASS_FRACTION * max(operators.mass.max(initial=0.0), 1e-300))
     heat = mass * float(falloff) / nearest**2
     if heated is not None:
         welded_heated = np.zeros(count, dtype=bool)
@@ -72,6 +72,6 @@ def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, he
         part_heated = np.zeros(labels.max() + 1, dtype=bool)
         part_heated[labels[welded_heated]] = True
         heat = np.where(welded_heated | ~part_heated[labels], heat, 0.0)
-    system = (-cotangent_laplacian(unit_V, welded_F) + sp.diags(heat)).tocsc()
+    system = (-operators.laplacian + sp.diags(heat)).tocsc()
     weights = splu(system, permc_spec="MMD_AT_PLUS_A").solve(np.asfortranarray(heat[:, None] * sources))
     return np.maximum(weights, 0.0)[to_welded]

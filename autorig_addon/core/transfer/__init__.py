@@ -4,7 +4,8 @@
 its normal agrees, :mod:`.inpainting` fills the rest smoothly, and
 :mod:`.transfer` runs both (:func:`transfer_weights`) with :mod:`.options`
 (:class:`TransferOptions`, the defaults and the bounds the panel and the
-command line offer).
+command line offer). :mod:`.source` checks and indexes the skinned source
+once (:class:`TransferSource`) for transfers onto many targets.
 """
 
 from .options import (
@@ -14,6 +15,7 @@ from .options import (
     DEFAULT_SMOOTHING_STRENGTH,
     TransferOptions,
 )
+from .source import TransferSource
 from .transfer import TransferResult, VertexStatus, transfer_weights
 
 __all__ = [
@@ -23,6 +25,7 @@ __all__ = [
     "DEFAULT_SMOOTHING_STRENGTH",
     "TransferOptions",
     "TransferResult",
+    "TransferSource",
     "VertexStatus",
     "transfer_weights",
 ]

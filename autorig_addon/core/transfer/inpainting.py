@@ -14,28 +14,29 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from ..geometry.bounding_box import bounding_box_diagonal
-from ..geometry.laplacian import cotangent_laplacian, voronoi_mass
+from ..geometry.laplacian import SurfaceOperators, surface_operators
 
 
-def inpainting_operator(V: np.ndarray, F: np.ndarray) -> sp.csr_matrix:
+def inpainting_operator(V: np.ndarray, F: np.ndarray, operators: SurfaceOperators | None = None) -> sp.csr_matrix:
     """``Q = -L + L M^-1 L`` (n, n), symmetric positive semi-definite.
 
-    The mesh is scaled to unit bounding-box diagonal first so the balance
-    between the Dirichlet term and the Laplacian energy term does not depend
-    on scene units.
+    The mesh is taken at unit bounding-box diagonal so the balance between
+    the Dirichlet term and the Laplacian energy term does not depend on
+    scene units.
 
     Parameters
     ----------
     V : (n, 3) float64 array
     F : (m, 3) int array
+    operators : SurfaceOperators of ``(V, F)`` when the caller has them
 
     Returns
     -------
     Q : (n, n) scipy.sparse.csr_matrix; ``Q @ 1 = 0``
     """
-    Vn = V / max(bounding_box_diagonal(V), 1e-300)
-    L = cotangent_laplacian(Vn, F)
-    mass = voronoi_mass(Vn, F)
+    operators = surface_operators(V, F) if operators is None else operators
+    L = operators.laplacian
+    mass = operators.mass_scaled(1.0 / max(bounding_box_diagonal(V), 1e-300))
     inverse_mass = np.divide(1.0, mass, out=np.zeros_like(mass), where=mass > 0)
     return (-L + L @ sp.diags(inverse_mass) @ L).tocsr()
 

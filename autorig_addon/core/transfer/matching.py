@@ -21,18 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from ..errors import InputError
 from ..geometry.bounding_box import bounding_box_diagonal
-from ..geometry.closest_point import SurfacePoints, TriangleMeshQuery
-from ..geometry.normals import vertex_normals
 from ..types import Mesh, Weights
-from ..weights import normalize_rows, usable_rows
+from .source import TransferSource
 
-#: A closest point drawing more than this share of its (barycentric) weight
-#: from source vertices without usable weights does not count as a match.
-MAX_UNWEIGHTED_SHARE = 1e-3
 #: Scale factors a unit mix-up gives, target size over the size it should
 #: have, with the units that differ by it; each is tried with its inverse.
 UNIT_FACTORS = {
@@ -76,32 +69,6 @@ class Matches:
     unweighted: np.ndarray
 
 
-def _weights_at(surface: SurfacePoints, source: Mesh, source_weights: np.ndarray,
-                points: np.ndarray, usable: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Source weights at ``surface``'s closest points of the (q, 3) ``points``;
-    ``usable`` (n_s,) bool are the source's usable rows when the caller
-    already has them (:func:`~autorig_addon.core.weights.usable_rows`).
-
-    Returns
-    -------
-    weights : (q, b) float64 array, rows normalised and non-empty (see :attr:`Matches.weights`)
-    weighted : (q,) bool array, the closest point carries usable weight
-    """
-    if usable is None:
-        usable = usable_rows(source_weights)
-    if not usable.any():
-        raise InputError(f"The source '{source.object_names[0]}' has no vertex with usable weights.")
-    clean = np.where(usable[:, None], normalize_rows(source_weights), 0.0)
-    weights = normalize_rows(surface.interpolate(source.triangles, clean))
-    share = surface.interpolate(source.triangles, usable.astype(np.float64))
-    weighted = share >= 1.0 - MAX_UNWEIGHTED_SHARE
-    if not weighted.all():
-        candidates = np.flatnonzero(usable)
-        _, nearest = cKDTree(source.vertices[candidates]).query(points[~weighted])
-        weights[~weighted] = clean[candidates[nearest]]
-    return weights, weighted
-
-
 def closest_point_weights(source: Mesh, source_weights: Weights, target: Mesh) -> Weights:
     """Every target vertex takes the source weights at its closest source
     surface point: plain copying, the baseline robust transfer improves on.
@@ -118,24 +85,21 @@ def closest_point_weights(source: Mesh, source_weights: Weights, target: Mesh) -
     (where the closest point has no usable weight, the nearest weighted
     source vertex's)
     """
-    surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    weights, _ = _weights_at(surface, source, source_weights.matrix, target.vertices)
+    prepared = TransferSource.prepare(source, source_weights)
+    weights, _ = prepared.weights_at(prepared.query.closest(target.vertices), target.vertices)
     return Weights(weights, source_weights.bone_names)
 
 
 def match_closest_points(
-    source: Mesh, source_weights: np.ndarray, target: Mesh, target_normals: np.ndarray,
+    source: TransferSource, target: Mesh, target_normals: np.ndarray,
     max_distance: float, max_normal_angle: float, accept_flipped_normals: bool,
-    source_usable: np.ndarray | None = None,
 ) -> Matches:
     """Match target vertices whose closest source point is near, carries
     usable weight and has a normal agreeing with the target's.
 
     Parameters
     ----------
-    source : Mesh with n_s vertices and at least one triangle
-    source_weights : (n_s, b) float64 array, raw: rows with NaN, infinite or
-        negative entries, or no weight, never match; at least one row usable
+    source : TransferSource; rows without usable weights never match
     target : Mesh with n vertices
     target_normals : (n, 3) float64 array, unit (zero where unknown)
     max_distance : float, scene units; farther points never match
@@ -143,33 +107,29 @@ def match_closest_points(
         the target normal and the interpolated source normal for a match
     accept_flipped_normals : bool, also match where the normals are opposite
         within the angle (inner layers, cloth modelled facing inwards)
-    source_usable : (n_s,) bool array, optional: the source's usable rows,
-        when the caller has already checked them (computed otherwise)
 
     Returns
     -------
     Matches
     """
-    surface = TriangleMeshQuery(source.vertices, source.triangles).closest(target.vertices)
-    weights, weighted = _weights_at(surface, source, source_weights, target.vertices, source_usable)
-    source_normals = vertex_normals(source.vertices, source.triangles)
-    candidate, flipped = _agreeing(surface, source.triangles, source_normals, target_normals, max_distance,
-                                   max_normal_angle, accept_flipped_normals)
+    surface = source.query.closest(target.vertices)
+    weights, weighted = source.weights_at(surface, target.vertices)
+    candidate, flipped = _agreeing(surface.distances, source.interpolated_normals(surface), target_normals,
+                                   max_distance, max_normal_angle, accept_flipped_normals)
     return Matches(weights, surface.distances, candidate & weighted, flipped & weighted, candidate & ~weighted)
 
 
-def _agreeing(surface: SurfacePoints, source_triangles: np.ndarray, source_vertex_normals: np.ndarray,
-              target_normals: np.ndarray, max_distance: float, max_normal_angle: float,
-              accept_flipped_normals: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(q,) bool arrays: closest points near enough whose normal agrees with
-    the (q, 3) ``target_normals`` (directly or, where accepted, opposite),
-    and those that agree only through opposite normals."""
-    source_normals = surface.interpolate(source_triangles, source_vertex_normals)
+def _agreeing(distances: np.ndarray, source_normals: np.ndarray, target_normals: np.ndarray, max_distance,
+              max_normal_angle: float, accept_flipped_normals: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(q,) bool arrays: closest points within ``max_distance`` (a float, or
+    one per point) whose interpolated source normal agrees with the (q, 3)
+    ``target_normals`` (directly or, where accepted, opposite), and those
+    that agree only through opposite normals."""
     length = np.linalg.norm(source_normals, axis=1)
     cosine = np.einsum("ij,ij->i", source_normals, target_normals) / np.maximum(length, 1e-300)
     cosine[length == 0] = 0.0
     cos_limit = np.cos(np.radians(max_normal_angle))
-    near = surface.distances <= max_distance
+    near = distances <= max_distance
     flipped = near & (cosine <= -cos_limit) if accept_flipped_normals else np.zeros(len(near), dtype=bool)
     return (near & (cosine >= cos_limit)) | flipped, flipped
 
@@ -201,7 +161,7 @@ class UnitFactor:
                 "the body.")
 
 
-def likely_unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, distance_fraction: float,
+def likely_unit_factor(source: TransferSource, target: Mesh, target_normals: np.ndarray, distance_fraction: float,
                        max_normal_angle: float, accept_flipped_normals: bool) -> UnitFactor | None:
     """The unit factor at which ``target`` best fits ``source``, if one fits
     much better than the current scale.
@@ -215,7 +175,8 @@ def likely_unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, d
 
     Parameters
     ----------
-    source, target : Mesh, world space, finite
+    source : TransferSource
+    target : Mesh, world space, finite
     target_normals : (n, 3) float64 array, unit normals of the target's vertices
     distance_fraction : float > 0, match distance as a fraction of the target's diagonal
     max_normal_angle : float, degrees; accept_flipped_normals : bool, as for :func:`match_closest_points`
@@ -227,26 +188,36 @@ def likely_unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, d
     """
     picked = np.unique(np.linspace(0, target.vertex_count - 1, UNIT_FACTOR_SAMPLES).astype(np.int64))
     sample, normals = target.vertices[picked], target_normals[picked]
-    query = TriangleMeshQuery(source.vertices, source.triangles)
-    source_normals = vertex_normals(source.vertices, source.triangles)
-    diagonal = bounding_box_diagonal(target.vertices)
+    match_distance = distance_fraction * bounding_box_diagonal(target.vertices)
 
-    def match_share(points: np.ndarray, scale: float) -> float:
-        matched, _ = _agreeing(query.closest(points), source.triangles, source_normals, normals,
-                               distance_fraction * diagonal * scale, max_normal_angle, accept_flipped_normals)
-        return float(np.mean(matched))
+    def match_shares(blocks: list[np.ndarray], limits: list[float]) -> np.ndarray:
+        """Share of each block of scaled samples that would match, in one query."""
+        points = np.concatenate(blocks)
+        distances = np.repeat(limits, len(sample))
+        near = ~source.query.surely_farther(points, distances)
+        surface = source.query.closest(points[near])
+        matched = np.zeros(len(points), dtype=bool)
+        matched[near], _ = _agreeing(surface.distances, source.interpolated_normals(surface),
+                                     np.tile(normals, (len(blocks), 1))[near], distances[near], max_normal_angle,
+                                     accept_flipped_normals)
+        return matched.reshape(len(blocks), len(sample)).mean(axis=1)
 
-    current = match_share(sample, 1.0)
-    if UNIT_FACTOR_MIN_GAIN * current > 1.0:
+    current = float(match_shares([sample], [match_distance])[0])
+    needed = max(UNIT_FACTOR_MIN_NEAR_SHARE, UNIT_FACTOR_MIN_GAIN * current)
+    if needed > 1.0:
         return None  # no scale can match twice as many
     centre = 0.5 * (target.vertices.min(axis=0) + target.vertices.max(axis=0))
-    best = None
-    for base, units in UNIT_FACTORS.items():
-        for factor in (base, 1.0 / base):
-            for pivot in (np.zeros(3), centre):
-                share = match_share(pivot + (sample - pivot) / factor, 1.0 / factor)
-                if best is None or share > best.near_share:
-                    best = UnitFactor(factor, units, share)
-    if best.near_share >= max(UNIT_FACTOR_MIN_NEAR_SHARE, UNIT_FACTOR_MIN_GAIN * current):
-        return best
-    return None
+    trials = [(factor, units, pivot) for base, units in UNIT_FACTORS.items()
+              for factor in (base, 1.0 / base) for pivot in (np.zeros(3), centre)]
+    blocks = [pivot + (sample - pivot) / factor for factor, _, pivot in trials]
+    limits = np.array([match_distance / factor for factor, _, _ in trials])
+    # A scale whose samples mostly lie far from every source vertex cannot
+    # reach the share needed: only the others take the exact test.
+    reachable = ~source.query.surely_farther(np.concatenate(blocks), np.repeat(limits, len(sample)))
+    hopeful = np.flatnonzero(reachable.reshape(len(trials), len(sample)).mean(axis=1) >= needed)
+    if not len(hopeful):
+        return None
+    shares = match_shares([blocks[i] for i in hopeful], limits[hopeful])
+    factor, units, _ = trials[hopeful[int(np.argmax(shares))]]
+    best = UnitFactor(factor, units, float(shares.max()))
+    return best if best.near_share >= needed else None

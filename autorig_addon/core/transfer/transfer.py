@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.laplacian import surface_operators
 from ..geometry.normals import vertex_normals
 from ..geometry.outliers import require_finite_positions
 from ..geometry.smoothing import smooth_over_edges, smooth_over_surface
@@ -50,10 +51,11 @@ from ..geometry.topology import connected_component_labels, non_manifold_edge_co
 from ..geometry.weld import weld_mesh
 from ..progress import ProgressCallback, report
 from ..types import Mesh, Weights
-from ..weights import empty_rows, invalid_rows, limit_influences, normalize_rows, prune_small, usable_rows
+from ..weights import empty_rows, limit_influences, normalize_rows, prune_small
 from .inpainting import inpaint_weights, inpainting_operator
 from .matching import Matches, UnitFactor, likely_unit_factor, match_closest_points
 from .options import MAX_SMOOTHING_LENGTH, MIN_SMOOTHING_LENGTH, TransferOptions
+from .source import TransferSource, prepared_source
 
 #: A target larger than this many source diagonals is taken as a unit mismatch.
 MAX_SCALE_RATIO = 5.0
@@ -159,6 +161,7 @@ def transfer_weights(
     protected: np.ndarray | None = None,
     protected_weights: Weights | None = None,
     progress: ProgressCallback | None = None,
+    prepared: TransferSource | None = None,
 ) -> TransferResult:
     """Weights for ``target`` from a skinned ``source`` surface.
 
@@ -173,6 +176,9 @@ def transfer_weights(
     protected_weights : Weights over any bones, (n_target, b'); matched to the
         source's bones by name, other bones ignored
     progress : ProgressCallback, may raise Cancelled
+    prepared : TransferSource made from these ``source`` and
+        ``source_weights`` objects (:meth:`TransferSource.prepare`), to
+        reuse its checks and index over many targets; made here when None
 
     Returns
     -------
@@ -180,7 +186,10 @@ def transfer_weights(
     """
     timings: dict[str, float] = {}
     clock = time.perf_counter()
-    source_usable = _check_inputs(source, source_weights, target, options)
+    if not len(target.triangles):
+        raise InputError(f"The target '{target.object_names[0]}' has no faces; it needs a surface to inpaint over.")
+    source = prepared_source(source, source_weights, prepared)
+    _check_inputs(source, target, options)
     n = target.vertex_count
     inpaint_mask = _optional_mask(inpaint_mask, n, "inpaint mask")
     protected = _optional_mask(protected, n, "protected set")
@@ -207,8 +216,7 @@ def transfer_weights(
     clock = time.perf_counter()
     welded_normals = vertex_normals(welded_V, welded_F)
     matches = match_closest_points(
-        source, source_weights.matrix, welded, welded_normals,
-        max_distance, options.max_normal_angle, options.accept_flipped_normals, source_usable,
+        source, welded, welded_normals, max_distance, options.max_normal_angle, options.accept_flipped_normals,
     )
     timings["match"] = time.perf_counter() - clock
     matched = matches.matched
@@ -226,9 +234,12 @@ def transfer_weights(
     status[matches.flipped] = VertexStatus.COPIED_FLIPPED
     status[masked] = VertexStatus.MASKED
     known = matched & ~masked
-    known_weights = matches.weights.copy()
+    # Only bones that weigh somewhere here are solved for and carried to the end.
+    bones = np.flatnonzero(matches.weights.any(axis=0) | (protected.any() and kept[protected].any(axis=0)))
+    fallback = matches.weights[:, bones]
+    known_weights = fallback.copy()
     if protected.any():
-        known_weights[protected_welded] = _mean_over_copies(kept, protected, to_welded, count)[protected_welded]
+        known_weights[protected_welded] = _mean_over_copies(kept[:, bones], protected, to_welded, count)[protected_welded]
         known |= protected_welded
         status[protected_welded] = VertexStatus.PROTECTED
     labels = connected_component_labels(welded_F, count)
@@ -236,14 +247,15 @@ def transfer_weights(
     if len(seeds):
         status[np.isin(labels, labels[seeds]) & ~known] = VertexStatus.UNMATCHED_PART
         known[seeds] = True
-    Q = inpainting_operator(welded_V, welded_F)
+    operators = surface_operators(welded_V, welded_F)
+    Q = inpainting_operator(welded_V, welded_F, operators)
     timings["system"] = time.perf_counter() - clock
     report(progress, 0.5, "Inpainting weights")
 
     clock = time.perf_counter()
     solved = normalize_rows(inpaint_weights(Q, known, known_weights))
     empty = ~(solved.sum(axis=1) > 0)
-    solved[empty] = matches.weights[empty]
+    solved[empty] = fallback[empty]
     timings["inpaint"] = time.perf_counter() - clock
     report(progress, 0.75, "Smoothing weights")
 
@@ -251,7 +263,8 @@ def transfer_weights(
     # Rows stay summing to one; limit_influences below clamps the slight dips
     # that non-Delaunay edges can give and renormalises.
     solved = smooth_over_surface(
-        solved, welded_V, welded_F, options.smoothing_length * source.bounding_box_diagonal, fixed=protected_welded,
+        solved, welded_V, welded_F, options.smoothing_length * source.diagonal, fixed=protected_welded,
+        operators=operators,
     )
     solved = smooth_over_edges(solved, welded_F, options.smoothing_iterations, options.smoothing_strength, rows=~known)
     solved = prune_small(limit_influences(solved, options.max_influences))
@@ -259,50 +272,27 @@ def transfer_weights(
     report(progress, 0.9, "Writing results")
 
     clock = time.perf_counter()
-    weights = solved[to_welded]
+    _require_normalised_rows(solved)
+    welded_weights = np.zeros((count, len(source_weights.bone_names)))
+    welded_weights[:, bones] = solved
+    weights = welded_weights[to_welded]
     if protected.any():
         weights[protected] = kept[protected]
-    _require_normalised_rows(weights)
     near_unweighted = matches.unweighted[to_welded] & (status[to_welded] != VertexStatus.MASKED) & ~protected
     timings["finish"] = time.perf_counter() - clock
     report(progress, 1.0, "Done")
     return TransferResult(
         Weights(weights, source_weights.bone_names), status[to_welded], float(max_distance), timings,
         welded_vertices=n - count, non_manifold_edges=non_manifold_edge_count(welded_F),
-        source_name=source.object_names[0],
-        unweighted_source_vertices=int(np.count_nonzero(~source_usable)),
-        invalid_source_vertices=int(np.count_nonzero(invalid_rows(source_weights.matrix))),
+        source_name=source.name,
+        unweighted_source_vertices=int(np.count_nonzero(~source.usable)),
+        invalid_source_vertices=source.invalid_count,
         near_unweighted=int(np.count_nonzero(near_unweighted)),
         unprotected=int(np.count_nonzero(unprotected)),
     )
 
 
-def check_source_weights(source: Mesh, source_weights: Weights) -> np.ndarray:
-    """(n_source,) bool: the source vertices with usable weights
-    (:func:`~autorig_addon.core.weights.usable_rows`).
-
-    Raises
-    ------
-    InputError when the rows do not match the vertices, or no vertex has
-    usable weights (saying whether the weights are missing or corrupt).
-    """
-    name = source.object_names[0]
-    if source_weights.vertex_count != source.vertex_count:
-        raise InputError("The source weights do not have one row per source vertex.")
-    usable = usable_rows(source_weights.matrix) if source_weights.bone_names else np.zeros(source.vertex_count, bool)
-    if usable.any():
-        return usable
-    invalid = int(np.count_nonzero(invalid_rows(source_weights.matrix)))
-    if invalid:
-        raise InputError(
-            f"The source '{name}' has no usable weights: {invalid} of its {source.vertex_count} vertices have NaN, "
-            "infinite or negative weights and the others none. Clean the weights (Weights > Clean) or skin "
-            "the body again."
-        )
-    raise InputError(f"The source '{name}' carries no bone weights to transfer.")
-
-
-def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+def check_match_quality(source: TransferSource, target: Mesh, target_normals: np.ndarray, matches: Matches,
                         eligible: np.ndarray, max_distance: float, options: TransferOptions) -> None:
     """Refuse a transfer that would mostly guess: fewer than
     :data:`MIN_COPIED_SHARE` of the ``eligible`` target vertices copy
@@ -315,7 +305,8 @@ def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, 
 
     Parameters
     ----------
-    source, target : Mesh (target welded, as matched)
+    source : TransferSource
+    target : Mesh, welded as matched
     target_normals : (n, 3) float64 array, unit normals of the target's vertices
     matches : Matches of the target's vertices
     eligible : (n,) bool array, vertices that may copy (neither masked nor protected)
@@ -326,7 +317,7 @@ def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, 
     copied = matches.matched & eligible
     if not candidates:
         return
-    source_name, target_name = source.object_names[0], target.object_names[0]
+    source_name, target_name = source.name, target.object_names[0]
     share = np.count_nonzero(copied) / candidates
     reason = (
         f"Only {100.0 * share:.0f}% of '{target_name}' ({np.count_nonzero(copied)} of {candidates} vertices) "
@@ -341,7 +332,7 @@ def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, 
         if factor is not None:
             raise InputError(f"{reason} {_unit_cause(factor, source, target)} {ALLOW_POOR_MATCH_HINT}")
     median = float(np.median(matches.distances[copied]))
-    source_size = source.bounding_box_diagonal
+    source_size = source.diagonal
     if median > MAX_MEDIAN_MATCH_FRACTION * source_size:
         raise InputError(
             f"'{target_name}' would copy weights from points of '{source_name}' {median:.3g} away (median), "
@@ -351,7 +342,7 @@ def check_match_quality(source: Mesh, target: Mesh, target_normals: np.ndarray, 
         )
 
 
-def poor_match_cause(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+def poor_match_cause(source: TransferSource, target: Mesh, target_normals: np.ndarray, matches: Matches,
                      eligible: np.ndarray, max_distance: float, options: TransferOptions) -> str:
     """Why few of the ``eligible`` vertices copy, as a sentence for the user,
     the surest cause first: another unit scale fits much better, most of
@@ -360,7 +351,7 @@ def poor_match_cause(source: Mesh, target: Mesh, target_normals: np.ndarray, mat
     factor = _unit_factor(source, target, target_normals, options)
     if factor is not None:
         return _unit_cause(factor, source, target)
-    source_name = source.object_names[0]
+    source_name = source.name
     copied = np.count_nonzero(matches.matched & eligible)
     unweighted = np.count_nonzero(matches.unweighted & eligible)
     if unweighted > copied:
@@ -376,22 +367,22 @@ def poor_match_cause(source: Mesh, target: Mesh, target_normals: np.ndarray, mat
             "or raise the match distance.")
 
 
-def _unit_factor(source: Mesh, target: Mesh, target_normals: np.ndarray, options: TransferOptions) -> UnitFactor | None:
+def _unit_factor(source: TransferSource, target: Mesh, target_normals: np.ndarray, options: TransferOptions) -> UnitFactor | None:
     return likely_unit_factor(source, target, target_normals, options.distance_fraction,
                               options.max_normal_angle, options.accept_flipped_normals)
 
 
-def _unit_cause(factor: UnitFactor, source: Mesh, target: Mesh) -> str:
-    return (f"{factor.describe(target.object_names[0], source.object_names[0])} "
+def _unit_cause(factor: UnitFactor, source: TransferSource, target: Mesh) -> str:
+    return (f"{factor.describe(target.object_names[0], source.name)} "
             "Fix the units or the object scale, then apply it (Ctrl+A).")
 
 
-def _no_match_message(source: Mesh, target: Mesh, target_normals: np.ndarray, matches: Matches,
+def _no_match_message(source: TransferSource, target: Mesh, target_normals: np.ndarray, matches: Matches,
                       max_distance: float, options: TransferOptions) -> str:
     everything = np.ones(len(matches.matched), dtype=bool)
     cause = poor_match_cause(source, target, target_normals, matches, everything, max_distance, options)
     return (f"No vertex of '{target.object_names[0]}' lies within {max_distance:.4g} of "
-            f"'{source.object_names[0]}' with agreeing normals on weighted parts. {cause} {ALLOW_POOR_MATCH_HINT}")
+            f"'{source.name}' with agreeing normals on weighted parts. {cause} {ALLOW_POOR_MATCH_HINT}")
 
 
 def _require_normalised_rows(weights: np.ndarray) -> None:
@@ -405,14 +396,9 @@ def _require_normalised_rows(weights: np.ndarray) -> None:
                              f"(first: vertex {int(np.flatnonzero(bad)[0])}).")
 
 
-def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: TransferOptions) -> np.ndarray:
-    """Raise :class:`InputError` for unusable input; returns the source's
-    usable rows (:func:`check_source_weights`)."""
-    if not len(source.triangles):
-        raise InputError(f"The source '{source.object_names[0]}' has no faces; weights are transferred from a surface.")
-    if not len(target.triangles):
-        raise InputError(f"The target '{target.object_names[0]}' has no faces; it needs a surface to inpaint over.")
-    usable = check_source_weights(source, source_weights)
+def _check_inputs(source: TransferSource, target: Mesh, options: TransferOptions) -> None:
+    """Raise :class:`InputError` for unusable options or a target that
+    cannot be on the source (the source is checked by :meth:`TransferSource.prepare`)."""
     if not (options.max_normal_angle > 0 and options.max_normal_angle <= 180):
         raise InputError("The normal angle must lie in (0, 180] degrees.")
     if options.max_distance is None and not options.distance_fraction > 0:
@@ -426,28 +412,28 @@ def _check_inputs(source: Mesh, source_weights: Weights, target: Mesh, options: 
     if not np.float32(MIN_SMOOTHING_LENGTH) <= np.float32(options.smoothing_length) <= np.float32(MAX_SMOOTHING_LENGTH):
         raise InputError(f"The smoothing length must lie in [{MIN_SMOOTHING_LENGTH:g}, {MAX_SMOOTHING_LENGTH:g}] "
                          "(a fraction of the source's size).")
-    for mesh in (source, target):
-        require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-    source_diagonal, target_diagonal = source.bounding_box_diagonal, target.bounding_box_diagonal
+    require_finite_positions(target.vertices, target.object_names, target.object_offsets)
+    source_name, target_name = source.name, target.object_names[0]
+    source_diagonal, target_diagonal = source.diagonal, target.bounding_box_diagonal
     if target_diagonal <= 0:
-        raise InputError(f"The target '{target.object_names[0]}' has zero size.")
+        raise InputError(f"The target '{target_name}' has zero size.")
     if target_diagonal > MAX_SCALE_RATIO * source_diagonal:
         factor = _unit_factor(source, target, vertex_normals(target.vertices, target.triangles), options)
         raise InputError(
-            f"The target '{target.object_names[0]}' is {target_diagonal / max(source_diagonal, 1e-300):.3g} times "
-            f"larger than the source '{source.object_names[0]}': they look like they are at different scales. "
+            f"The target '{target_name}' is {target_diagonal / max(source_diagonal, 1e-300):.3g} times "
+            f"larger than the source '{source_name}': they look like they are at different scales. "
             + (_unit_cause(factor, source, target) if factor is not None else
                "Apply their scale (Ctrl+A) or fix the units.")
         )
     margin = options.distance_fraction * target_diagonal if options.max_distance is None else options.max_distance
-    source_min, source_max = source.vertices.min(0) - margin, source.vertices.max(0) + margin
+    source_vertices = source.mesh.vertices
+    source_min, source_max = source_vertices.min(0) - margin, source_vertices.max(0) + margin
     target_min, target_max = target.vertices.min(0), target.vertices.max(0)
     if np.any(target_min > source_max) or np.any(target_max < source_min):
         raise InputError(
-            f"'{target.object_names[0]}' does not overlap the source '{source.object_names[0]}': "
+            f"'{target_name}' does not overlap the source '{source_name}': "
             "move the garment onto the body (or apply the object transforms) before transferring."
         )
-    return usable
 
 
 def _optional_mask(mask: np.ndarray | None, n: int, what: str) -> np.ndarray:
