@@ -124,3 +124,14 @@ def test_surely_farther_never_rules_out_a_point_within_the_distance():
                                  axis=1).max() for k in range(3))
     clearly = exact > limits + 2 * longest
     assert clearly.sum() > 500 and farther[clearly].all()
+
+
+def test_a_point_over_a_shared_edge_goes_to_the_triangle_with_the_nearest_centroid():
+    # Two triangles of a soup meet along x; the query lies over their edge,
+    # at the same distance from both. The small triangle, listed second, is
+    # the one it lies nearer to: its normal is the one a faceted body shows there.
+    V = np.array([[1.0, 0, 0], [0, 0, 0], [0.5, -2, 0], [0, 0, 0], [1.0, 0, 0], [0.5, 0.2, 0]])
+    F = np.array([[0, 1, 2], [3, 4, 5]])
+    result = TriangleMeshQuery(V, F).closest(np.array([[0.5, 0.0, 0.1], [0.3, 0.0, -0.2]]))
+    np.testing.assert_allclose(result.distances, [0.1, 0.2], atol=1e-12)
+    np.testing.assert_array_equal(result.triangles, [1, 1])

@@ -167,8 +167,11 @@ class TriangleMeshQuery:
         vi = self._used_vertices[np.asarray(vi).reshape(q, k_v)]
         ci = np.asarray(ci).reshape(q, k_c)
         around = self._vertex_triangles[vi].reshape(q, -1)  # -1 pads
-        # Sorted, so a triangle found both ways is tested once.
-        candidates = np.sort(np.concatenate([ci, around], axis=1), axis=1)
+        found = np.concatenate([ci, around], axis=1)
+        # Sorted, so a triangle found both ways is tested once; ``rank`` is
+        # the order they were found in (nearest centroids first).
+        rank = np.argsort(found, axis=1, kind="stable")
+        candidates = np.take_along_axis(found, rank, axis=1)
         fresh = np.ones(candidates.shape, dtype=bool)
         fresh[:, 1:] = candidates[:, 1:] != candidates[:, :-1]
         # The nearest vertex lies on the surface, so the closest point is no
@@ -184,9 +187,13 @@ class TriangleMeshQuery:
         points, bary = closest_points_on_triangles(P[rows], self.V[tri[:, 0]], self.V[tri[:, 1]], self.V[tri[:, 2]])
         d2 = np.sum((points - P[rows]) ** 2, axis=1)
         starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
-        nearest = np.minimum.reduceat(d2, starts)
-        # Per query, its first candidate at the least distance.
-        hits = np.flatnonzero(d2 == nearest[rows])
+        at_least = d2 == np.minimum.reduceat(d2, starts)[rows]
+        # Triangles meeting at the closest point (on their shared edge or
+        # corner) tie; the one found first holds it, the nearest centroid's
+        # (on a faceted surface its normal is the one facing the query).
+        tie_break = np.where(at_least, rank[rows, slots], len(rank.T))
+        best = at_least & (tie_break == np.minimum.reduceat(tie_break, starts)[rows])
+        hits = np.flatnonzero(best)
         first = hits[np.r_[True, rows[hits][1:] != rows[hits][:-1]]]
         return SurfacePoints(points[first], np.sqrt(d2[first]), triangles[first], bary[first])
 

@@ -189,6 +189,8 @@ def transfer_weights(
     if not len(target.triangles):
         raise InputError(f"The target '{target.object_names[0]}' has no faces; it needs a surface to inpaint over.")
     source = prepared_source(source, source_weights, prepared)
+    timings["source"] = time.perf_counter() - clock
+    clock = time.perf_counter()
     _check_inputs(source, target, options)
     n = target.vertex_count
     inpaint_mask = _optional_mask(inpaint_mask, n, "inpaint mask")
