@@ -129,7 +129,8 @@ class TriangleMeshQuery:
         self._radii = np.sqrt(((corners - centroids[:, None]) ** 2).sum(axis=2).max(axis=1))
         self._vertex_triangles = _vertex_triangle_table(self.F, len(self.V))
         # Every surface point lies within its triangle's longest edge of a corner.
-        self._longest_edge = float(np.sqrt(max(((corners - np.roll(corners, 1, axis=1)) ** 2).sum(axis=2).max(), 0.0)))
+        squared_edges = ((corners - np.roll(corners, 1, axis=1)) ** 2).sum(axis=2)
+        self._longest_edge = float(np.sqrt(squared_edges.max()))
 
     def surely_farther(self, P: np.ndarray, distances) -> np.ndarray:
         """(q,) bool: points of ``P`` (q, 3) certainly farther than
@@ -187,12 +188,12 @@ class TriangleMeshQuery:
         points, bary = closest_points_on_triangles(P[rows], self.V[tri[:, 0]], self.V[tri[:, 1]], self.V[tri[:, 2]])
         d2 = np.sum((points - P[rows]) ** 2, axis=1)
         starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
-        at_least = d2 == np.minimum.reduceat(d2, starts)[rows]
+        nearest_here = d2 == np.minimum.reduceat(d2, starts)[rows]
         # Triangles meeting at the closest point (on their shared edge or
         # corner) tie; the one found first holds it, the nearest centroid's
         # (on a faceted surface its normal is the one facing the query).
-        tie_break = np.where(at_least, rank[rows, slots], len(rank.T))
-        best = at_least & (tie_break == np.minimum.reduceat(tie_break, starts)[rows])
+        tie_break = np.where(nearest_here, rank[rows, slots], len(rank.T))
+        best = nearest_here & (tie_break == np.minimum.reduceat(tie_break, starts)[rows])
         hits = np.flatnonzero(best)
         first = hits[np.r_[True, rows[hits][1:] != rows[hits][:-1]]]
         return SurfacePoints(points[first], np.sqrt(d2[first]), triangles[first], bary[first])
