@@ -46,9 +46,8 @@ def invalid_rows(weights: np.ndarray) -> np.ndarray:
     >>> invalid_rows(np.array([[0.5, 0.5], [np.nan, 1.0], [1.0, -0.5], [0.0, 0.0]])).tolist()
     [False, True, True, False]
     """
-    weights = np.asarray(weights, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        return ~np.all(np.isfinite(weights) & (weights >= 0.0), axis=1)
+    low, high = _row_extremes(weights)
+    return _invalid_given(low, high)
 
 
 def usable_rows(weights: np.ndarray) -> np.ndarray:
@@ -60,10 +59,25 @@ def usable_rows(weights: np.ndarray) -> np.ndarray:
     >>> usable_rows(np.array([[0.5, 0.5], [np.nan, 1.0], [0.0, 0.0], [1e-6, 0.0]])).tolist()
     [True, False, False, False]
     """
+    low, high = _row_extremes(weights)
+    # A row's largest weight tells whether it is empty (a row with NaN, whose
+    # largest is NaN, is invalid anyway).
+    return ~_invalid_given(low, high) & (high > INFLUENCE_EPSILON)
+
+
+def _row_extremes(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's smallest and largest entry, NaN where the row holds one:
+    two reductions, far cheaper than element-wise tests on a big matrix."""
     weights = np.asarray(weights, dtype=np.float64)
-    # NaN compares False, so empty_rows needs no cleaning: a row with NaN is invalid anyway.
+    if not weights.shape[1]:
+        return np.zeros(len(weights)), np.zeros(len(weights))
+    return weights.min(axis=1), weights.max(axis=1)
+
+
+def _invalid_given(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Rows with a NaN, infinite or negative entry, from their extremes."""
     with np.errstate(invalid="ignore"):
-        return ~invalid_rows(weights) & ~empty_rows(weights)
+        return ~(low >= 0.0) | ~np.isfinite(high)
 
 
 def limit_influences(weights: np.ndarray, max_influences: int) -> np.ndarray:

@@ -85,10 +85,11 @@ class TransferSource:
                 )
             raise InputError(f"The source '{name}' carries no bone weights to transfer.")
         require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-        rows, columns = np.nonzero((matrix > 0) & usable[:, None])
+        rows, columns = np.nonzero((matrix > 0) & usable[:, None])  # row by row, as CSR stores them
         values = matrix[rows, columns]
         values /= np.bincount(rows, weights=values, minlength=mesh.vertex_count)[rows]
-        clean = sp.csr_matrix((values, (rows, columns)), shape=matrix.shape)
+        row_starts = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=mesh.vertex_count))])
+        clean = sp.csr_matrix((values, columns, row_starts), shape=matrix.shape)
         return cls(
             mesh=mesh,
             weights=weights,
