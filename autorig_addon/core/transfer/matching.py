@@ -190,34 +190,35 @@ def likely_unit_factor(source: TransferSource, target: Mesh, target_normals: np.
     sample, normals = target.vertices[picked], target_normals[picked]
     match_distance = distance_fraction * bounding_box_diagonal(target.vertices)
 
-    def match_shares(blocks: list[np.ndarray], limits: list[float]) -> np.ndarray:
-        """Share of each block of scaled samples that would match, in one query."""
-        points = np.concatenate(blocks)
-        distances = np.repeat(limits, len(sample))
-        near = ~source.query.surely_farther(points, distances)
+    def match_shares(points: np.ndarray, distances: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """Share of each block of ``len(sample)`` scaled samples that would
+        match, in one query; ``near``: the points not surely too far."""
         surface = source.query.closest(points[near])
         matched = np.zeros(len(points), dtype=bool)
         matched[near], _ = _agreeing(surface.distances, source.interpolated_normals(surface),
-                                     np.tile(normals, (len(blocks), 1))[near], distances[near], max_normal_angle,
-                                     accept_flipped_normals)
-        return matched.reshape(len(blocks), len(sample)).mean(axis=1)
+                                     np.tile(normals, (len(points) // len(sample), 1))[near], distances[near],
+                                     max_normal_angle, accept_flipped_normals)
+        return matched.reshape(-1, len(sample)).mean(axis=1)
 
-    current = float(match_shares([sample], [match_distance])[0])
+    current_distances = np.full(len(sample), match_distance)
+    current = float(match_shares(sample, current_distances,
+                                 ~source.query.surely_farther(sample, current_distances))[0])
     needed = max(UNIT_FACTOR_MIN_NEAR_SHARE, UNIT_FACTOR_MIN_GAIN * current)
     if needed > 1.0:
         return None  # no scale can match twice as many
     centre = 0.5 * (target.vertices.min(axis=0) + target.vertices.max(axis=0))
     trials = [(factor, units, pivot) for base, units in UNIT_FACTORS.items()
               for factor in (base, 1.0 / base) for pivot in (np.zeros(3), centre)]
-    blocks = [pivot + (sample - pivot) / factor for factor, _, pivot in trials]
-    limits = np.array([match_distance / factor for factor, _, _ in trials])
-    # A scale whose samples mostly lie far from every source vertex cannot
-    # reach the share needed: only the others take the exact test.
-    reachable = ~source.query.surely_farther(np.concatenate(blocks), np.repeat(limits, len(sample)))
-    hopeful = np.flatnonzero(reachable.reshape(len(trials), len(sample)).mean(axis=1) >= needed)
+    points = np.concatenate([pivot + (sample - pivot) / factor for factor, _, pivot in trials])
+    distances = np.repeat([match_distance / factor for factor, _, _ in trials], len(sample))
+    near = ~source.query.surely_farther(points, distances)
+    # A scale whose samples mostly lie surely too far cannot reach the share
+    # needed: only the others take the exact test.
+    hopeful = np.flatnonzero(near.reshape(len(trials), len(sample)).mean(axis=1) >= needed)
     if not len(hopeful):
         return None
-    shares = match_shares([blocks[i] for i in hopeful], limits[hopeful])
+    rows = (hopeful[:, None] * len(sample) + np.arange(len(sample))).ravel()
+    shares = match_shares(points[rows], distances[rows], near[rows])
     factor, units, _ = trials[hopeful[int(np.argmax(shares))]]
     best = UnitFactor(factor, units, float(shares.max()))
     return best if best.near_share >= needed else None

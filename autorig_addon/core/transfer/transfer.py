@@ -237,7 +237,10 @@ def transfer_weights(
     status[masked] = VertexStatus.MASKED
     known = matched & ~masked
     # Only bones that weigh somewhere here are solved for and carried to the end.
-    bones = np.flatnonzero(matches.weights.any(axis=0) | (protected.any() and kept[protected].any(axis=0)))
+    weighing = matches.weights.any(axis=0)
+    if protected.any():
+        weighing |= kept[protected].any(axis=0)
+    bones = np.flatnonzero(weighing)
     fallback = matches.weights[:, bones]
     known_weights = fallback.copy()
     if protected.any():
