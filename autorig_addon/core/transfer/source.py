@@ -10,7 +10,8 @@ and reused by every :func:`~.transfer.transfer_weights` call given the same
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -55,7 +56,6 @@ class TransferSource:
     query: TriangleMeshQuery
     normals: np.ndarray
     diagonal: float
-    _usable_tree: list = field(default_factory=list, repr=False)
 
     @classmethod
     def prepare(cls, mesh: Mesh, weights: Weights) -> "TransferSource":
@@ -126,7 +126,7 @@ class TransferSource:
         share = surface.interpolate(triangles, self.usable.astype(np.float64))
         weighted = share >= 1.0 - MAX_UNWEIGHTED_SHARE
         if not weighted.all():
-            candidates, tree = self._nearest_usable_index()
+            candidates, tree = self._nearest_usable_index
             _, nearest = tree.query(points[~weighted])
             weights[~weighted] = self.clean_weights[candidates[nearest]].toarray()
         return weights, weighted
@@ -136,12 +136,11 @@ class TransferSource:
         the closest points (not unit length)."""
         return surface.interpolate(self.mesh.triangles, self.normals)
 
+    @cached_property
     def _nearest_usable_index(self) -> tuple[np.ndarray, cKDTree]:
         # Built on first need: most bodies are weighted everywhere.
-        if not self._usable_tree:
-            candidates = np.flatnonzero(self.usable)
-            self._usable_tree.append((candidates, cKDTree(self.mesh.vertices[candidates])))
-        return self._usable_tree[0]
+        candidates = np.flatnonzero(self.usable)
+        return candidates, cKDTree(self.mesh.vertices[candidates])
 
 
 def prepared_source(source: Mesh, source_weights: Weights, prepared: TransferSource | None) -> TransferSource:
