@@ -3,7 +3,8 @@
 Exactness matters for weight transfer: snapping to the closest *vertex*
 instead of the closest *surface point* picks the wrong side of a coarse body
 and mis-weights garments. We find candidate triangles with KD-trees and run
-an exact point-triangle test on all candidates at once.
+an exact point-triangle test on all of them at once, leaving out those that
+provably cannot hold the closest point.
 """
 
 from __future__ import annotations
@@ -136,7 +137,9 @@ class TriangleMeshQuery:
         """(q,) bool: points of ``P`` (q, 3) certainly farther than
         ``distances`` (a float or (q,) array) from the surface, from their
         nearest vertex alone: a cheap test that spares the exact one for
-        points far from the mesh."""
+        points far from the mesh. Points are queried in one group per
+        distinct distance, so pass few distinct distances (the unit check
+        passes one per trial scale)."""
         P = np.asarray(P, dtype=np.float64).reshape(-1, 3)
         distances = np.broadcast_to(np.asarray(distances, dtype=np.float64), (len(P),))
         farther = np.ones(len(P), dtype=bool)
