@@ -1,0 +1,113 @@
+"""What the shipped networks give on small generated characters, recorded
+once so a test can tell that a change of the code left every network's
+output as it was (``test_shipped_network_outputs.py``).
+
+Record again only when the shipped weights change on purpose (a retraining),
+and say so in the commit::
+
+    .venv/bin/python tests/network_outputs.py
+
+It writes :data:`NETWORK_OUTPUTS_FILE` (float32 outputs, about 150 kB):
+
+* each skinning network's candidate weights on the network graph of the
+  procedural character of seed :data:`SKIN_SEED`, and its finished weights
+  on that mesh;
+* the joint network's offsets and attention on the joint graph of the same
+  character, and the bone and root networks' outputs on the joints of the
+  skeleton predicted for it;
+* the skeleton predicted for the procedural biped of seed
+  :data:`BIPED_SEED` (joints, tails, parents, names).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from autorig_addon.core.dataset.normalise import normalise  # noqa: E402
+from autorig_addon.core.dataset.sample import CharacterSample  # noqa: E402
+from autorig_addon.core.procedural import generate_character  # noqa: E402
+from autorig_addon.core.rigging import predict as rig_predict  # noqa: E402
+from autorig_addon.core.rigging.connectivity import (  # noqa: E402
+    bone_probabilities, candidate_pairs, pair_features, root_features, root_scores,
+)
+from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth  # noqa: E402
+from autorig_addon.core.rigging.joint_network import joint_outputs  # noqa: E402
+from autorig_addon.core.skinning.learned import predict as skin_predict  # noqa: E402
+
+NETWORK_OUTPUTS_FILE = Path(__file__).resolve().parent / "data" / "network_outputs.npz"
+#: The procedural character every network runs on (a 30-bone chain of 762 vertices).
+SKIN_SEED = 5
+#: A procedural biped (1,782 vertices, 29 bones) for a whole skeleton prediction.
+BIPED_SEED = 23
+#: Voxel resolution of the distances and depths (the default 96 is slower and
+#: changes nothing these records check).
+RESOLUTION = 32
+SKIN_NETWORKS = ("rignet", "heterskinnet", "skinningnet")
+
+
+def sample_of(seed: int) -> CharacterSample:
+    character = generate_character(seed)
+    return CharacterSample.from_character(f"procedural_{seed}", character.kind, character.mesh, character.skeleton,
+                                          character.weights)
+
+
+def skin_outputs() -> dict:
+    """``skin.NAME.candidates`` (n, K) and ``skin.NAME.weights`` (n, d) per network."""
+    sample = sample_of(SKIN_SEED)
+    normalised = normalise(sample.mesh, sample.skeleton.deform_subset())
+    arrays = {}
+    for name in SKIN_NETWORKS:
+        distance = skin_predict.network_distance(name)
+        graph = skin_predict.network_graph(normalised.mesh, normalised.skeleton, distance,
+                                           prior=skin_predict.NETWORK_PRIORS[name], resolution=RESOLUTION)
+        arrays[f"skin.{name}.candidates"] = skin_predict.network_candidate_weights(name, graph).astype(np.float32)
+        weights = skin_predict.learned_weights(sample.mesh, sample.skeleton, name, resolution=RESOLUTION)
+        arrays[f"skin.{name}.weights"] = weights.matrix.astype(np.float32)
+    return arrays
+
+
+def rig_outputs() -> dict:
+    """The joint network's ``joints.offsets`` (n, 3) and ``joints.attention``
+    (n,), then ``bones.probabilities`` and ``root.scores`` on the joints
+    that a mean shift of those votes finds."""
+    mesh = sample_of(SKIN_SEED).mesh
+    solid = solid_depth(mesh, RESOLUTION)
+    graph = joint_graph(mesh, solid)
+    offsets, attention = joint_outputs(rig_predict.trained_network("joints"), graph)
+    votes = rig_predict.graph_votes(rig_predict.trained_network("joints"), graph, solid)
+    joints, mirror = rig_predict.cluster_joints(votes, rig_predict.DEFAULT_BANDWIDTH, 0.0, True)
+    pairs = candidate_pairs(joints)
+    return {
+        "joints.offsets": offsets.astype(np.float32),
+        "joints.attention": attention.astype(np.float32),
+        "bones.probabilities": bone_probabilities(rig_predict.trained_network("bones"),
+                                                  pair_features(joints, pairs, solid, mirror)).astype(np.float32),
+        "root.scores": root_scores(rig_predict.trained_network("root"), root_features(joints, solid)).astype(np.float32),
+    }
+
+
+def skeleton_outputs() -> dict:
+    """The skeleton predicted for the biped, in its own space."""
+    skeleton = rig_predict.predict_skeleton(sample_of(BIPED_SEED).mesh)
+    return {"skeleton.joints": skeleton.joints.astype(np.float32),
+            "skeleton.tails": skeleton.tails.astype(np.float32),
+            "skeleton.parents": skeleton.parents.astype(np.int64),
+            "skeleton.names": np.asarray(skeleton.names)}
+
+
+def record() -> None:
+    arrays = {**skin_outputs(), **rig_outputs(), **skeleton_outputs()}
+    NETWORK_OUTPUTS_FILE.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(NETWORK_OUTPUTS_FILE, **arrays)
+    print(f"{len(arrays)} arrays in {NETWORK_OUTPUTS_FILE} ({NETWORK_OUTPUTS_FILE.stat().st_size / 1e3:.0f} kB)",
+          file=sys.stderr)
+
+
+if __name__ == "__main__":
+    record()
