@@ -6,6 +6,7 @@ sits at the repository top, so a build stages a temporary directory::
     STAGE/__init__.py, core/, blender/, ...   contents of autorig_addon/ (less the
                                               torch-only core/nn/training/)
     STAGE/blender_manifest.toml               platforms + wheels rewritten
+    STAGE/LICENSE                             the GPL-3.0 text
     STAGE/wheels/*.whl                        the dependencies Blender lacks (scipy)
 
 and runs Blender's own extension builder (``blender_ext.py build
@@ -238,6 +239,8 @@ def stage_extension(stage_dir: str, wheels_by_platform: dict[str, list[str]]) ->
     """Fill ``stage_dir`` with the add-on sources, the rewritten manifest and
     the wheels of every platform in ``wheels_by_platform``."""
     copy_addon_sources(stage_dir)
+    # The licence text the manifest's `license` names (GPL-3.0-or-later) ships beside the code.
+    shutil.copy2(REPO_ROOT / "LICENSE", os.path.join(stage_dir, "LICENSE"))
     wheel_dir = os.path.join(stage_dir, WHEELS_FOLDER)
     os.makedirs(wheel_dir, exist_ok=True)
     names = []

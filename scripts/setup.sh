@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Create .venv (Python 3.11, the Python of Blender 4.2-5.0 and of the bpy
-# wheel) and install requirements.txt into it. Safe to run again.
+# wheel), install requirements.txt into it and the package itself (editable).
+# Safe to run again.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -21,3 +22,6 @@ if [ "${venv_version}" != "${REQUIRED_PYTHON}" ]; then
     exit 1
 fi
 .venv/bin/pip install -q -r requirements.txt
+# The package itself, editable: `import autorig_addon` works from any folder
+# (scripts/, bench/, subprocesses) and edits take effect without reinstalling.
+.venv/bin/pip install -q --no-deps -e .

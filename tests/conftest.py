@@ -4,16 +4,11 @@ Blender-backed fixtures import ``bpy`` lazily, so test modules that only
 exercise ``core`` never load Blender.
 """
 
-import sys
 from pathlib import Path
 
 import pytest
 
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
-TESTS_DIRECTORY = Path(__file__).resolve().parent
-for _path in (str(REPOSITORY_ROOT), str(TESTS_DIRECTORY)):
-    if _path not in sys.path:
-        sys.path.insert(0, _path)
 
 
 @pytest.fixture(scope="session")

@@ -49,8 +49,30 @@ def test_repo_manifest_is_complete():
     assert manifest["platforms"] == ["linux-x64", "windows-x64", "macos-x64", "macos-arm64"]
     assert list(packaging.PLATFORM_TARGETS) == manifest["platforms"]
     assert manifest["wheels"] == [f"./wheels/{name}" for name in EXPECTED_WHEELS.values()]
-    with open(packaging.ADDON_DIR / "__init__.py") as handle:
-        assert f'__version__ = "{manifest["version"]}"' in handle.read()
+
+
+def test_the_manifest_is_the_one_source_of_the_version():
+    """The package and its installed metadata (pyproject.toml reads the
+    package) give the manifest's version, which no other file repeats."""
+    import autorig_addon
+
+    version = tomllib.loads(packaging.MANIFEST_PATH.read_text())["version"]
+    assert autorig_addon.__version__ == version
+    assert importlib.metadata.version("autorig_addon") == version
+    for path in (packaging.ADDON_DIR / "__init__.py", packaging.REPO_ROOT / "pyproject.toml"):
+        assert version not in path.read_text(), path
+
+
+def test_the_stage_holds_the_licence_and_the_manifest_beside_the_package(tmp_path):
+    """Inside the installed extension the manifest sits next to __init__.py
+    (where the package reads its version) and the GPL text comes along."""
+    packaging.stage_extension(str(tmp_path), {})
+    assert (tmp_path / "LICENSE").read_bytes() == (packaging.REPO_ROOT / "LICENSE").read_bytes()
+    assert (tmp_path / "LICENSE").read_text().startswith("                    GNU GENERAL PUBLIC LICENSE\n"
+                                                         "                       Version 3, 29 June 2007\n")
+    assert (tmp_path / "__init__.py").is_file()
+    staged = tomllib.loads((tmp_path / packaging.MANIFEST_FILENAME).read_text())
+    assert staged["version"] == tomllib.loads(packaging.MANIFEST_PATH.read_text())["version"]
 
 
 def test_manifest_text_rewrites_only_platforms_and_wheels():
