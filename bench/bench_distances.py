@@ -24,18 +24,14 @@ import time
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.distances.bone_distances import validate_bones, voxelize_covering_bones  # noqa: E402
-from autorig_addon.core.distances.cell_graph import bone_node_distances  # noqa: E402
-from autorig_addon.core.distances.hollow_dist import build_hollow_graph, refine_hollow_in_sight  # noqa: E402
-from autorig_addon.core.distances.interior import fill_interior  # noqa: E402
-from autorig_addon.core.distances.vertex_distances import combine_vertex_distances, vertex_cell_candidates  # noqa: E402
-from autorig_addon.core.distances.volumetric_geodesic import build_geodesic_graph, refine_geodesic_in_sight  # noqa: E402
-from autorig_addon.core.types import Mesh, Skeleton  # noqa: E402
+from autorig_addon.core.distances.bone_distances import validate_bones, voxelize_covering_bones
+from autorig_addon.core.distances.cell_graph import bone_node_distances
+from autorig_addon.core.distances.hollow_dist import build_hollow_graph, refine_hollow_in_sight
+from autorig_addon.core.distances.interior import fill_interior
+from autorig_addon.core.distances.vertex_distances import combine_vertex_distances, vertex_cell_candidates
+from autorig_addon.core.distances.volumetric_geodesic import build_geodesic_graph, refine_geodesic_in_sight
+from autorig_addon.core.types import Mesh, Skeleton
+from memory import peak_rss_added
 
 #: Each distance kind's own stages (graph, line of sight); the others are shared
 #: (see ``autorig_addon.core.distances.bone_distances``).

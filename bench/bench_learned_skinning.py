@@ -18,22 +18,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, REPO)
-sys.path.insert(0, BENCH)
-
-from bench_skinning import character, write_cache  # noqa: E402
-from memory import _status_mib, peak_rss_added  # noqa: E402
-from autorig_addon.core.skinning.geometric import geometric_weights  # noqa: E402
-from autorig_addon.core.skinning.learned.predict import NETWORK_NAMES, learned_weights  # noqa: E402
+from autorig_addon.core.skinning.geometric import geometric_weights
+from autorig_addon.core.skinning.learned.predict import NETWORK_NAMES, learned_weights
+from bench_skinning import character, write_cache
+from memory import _status_mib, peak_rss_added
 
 METHODS = ("geometric",) + NETWORK_NAMES
 

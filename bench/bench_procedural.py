@@ -8,16 +8,13 @@ count range.
 """
 
 import argparse
-import os
 import statistics
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from autorig_addon.core.procedural import generate_character  # noqa: E402
+from autorig_addon.core.procedural import generate_character
 
 
 def main(argv=None) -> int:

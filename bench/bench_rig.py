@@ -37,15 +37,12 @@ import sys
 import tempfile
 import time
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, REPO)
-sys.path.insert(0, BENCH)
+from autorig_addon.core.rigging import predict
+from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD, skin_weights
+from bench_skinning import character
+from memory import _status_mib, peak_rss_added
 
-from bench_skinning import character  # noqa: E402
-from memory import _status_mib, peak_rss_added  # noqa: E402
-from autorig_addon.core.rigging import predict  # noqa: E402
-from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD, skin_weights  # noqa: E402
+BENCH = os.path.dirname(os.path.abspath(__file__))
 
 #: Bandwidths of the re-clustering rows (share of the largest side): the
 #: finest the slider allows, the default, coarse.
@@ -118,9 +115,9 @@ def main(argv=None) -> int:
     results = []
     with tempfile.TemporaryDirectory() as folder:
         if any(size != "5k" for size in args.sizes):
-            child = subprocess.run([sys.executable, "-c", f"import sys; sys.path[:0] = [{REPO!r}, {BENCH!r}]; "
-                                    f"import bench_skinning; bench_skinning.write_cache({folder!r})"],
-                                   capture_output=True, text=True)
+            # Run in bench/, where "-c" finds bench_skinning.
+            child = subprocess.run([sys.executable, "-c", f"import bench_skinning; bench_skinning.write_cache({folder!r})"],
+                                   capture_output=True, text=True, cwd=BENCH)
             if child.returncode:
                 sys.stderr.write(child.stderr)
                 return 1

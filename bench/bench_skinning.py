@@ -46,17 +46,15 @@ import time
 
 import numpy as np
 
+from autorig_addon.core.geometry.subdivision import subdivide_midpoints
+from autorig_addon.core.geometry.weld import weld_mesh
+from autorig_addon.core.skinning import geometric
+from autorig_addon.core.types import Mesh, Skeleton
+from autorig_addon.core.weights import normalize_rows
+from memory import _status_mib, peak_rss_added
+
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BENCH = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, REPO)
-sys.path.insert(0, BENCH)
-
-from memory import _status_mib, peak_rss_added  # noqa: E402
-from autorig_addon.core.geometry.subdivision import subdivide_midpoints  # noqa: E402
-from autorig_addon.core.geometry.weld import weld_mesh  # noqa: E402
-from autorig_addon.core.skinning import geometric  # noqa: E402
-from autorig_addon.core.types import Mesh, Skeleton  # noqa: E402
-from autorig_addon.core.weights import normalize_rows  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 #: How the table names the two paths.
@@ -180,8 +178,9 @@ def main(argv=None) -> int:
         print(json.dumps(run_size(args.cache, args.one, args.paths, args.repeat)))
         return 0
     with tempfile.TemporaryDirectory() as folder:
-        child = subprocess.run([sys.executable, "-c", f"import sys; sys.path[:0] = [{REPO!r}, {BENCH!r}]; "
-                                f"import bench_skinning; bench_skinning.write_cache({folder!r})"], capture_output=True, text=True)
+        # Run in bench/, where "-c" finds bench_skinning.
+        child = subprocess.run([sys.executable, "-c", f"import bench_skinning; bench_skinning.write_cache({folder!r})"],
+                               capture_output=True, text=True, cwd=BENCH)
         if child.returncode:
             sys.stderr.write(child.stderr)
             return 1

@@ -20,13 +20,11 @@ import statistics
 import sys
 import time
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from autorig_addon.core.transfer import TransferOptions, transfer_weights
+from autorig_addon.core.transfer.matching import closest_point_weights
+from memory import peak_rss_added
 
-from memory import peak_rss_added  # noqa: E402
-from autorig_addon.core.transfer import TransferOptions, transfer_weights  # noqa: E402
-from autorig_addon.core.transfer.matching import closest_point_weights  # noqa: E402
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 

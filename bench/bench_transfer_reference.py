@@ -42,7 +42,6 @@ import time
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 

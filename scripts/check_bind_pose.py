@@ -24,16 +24,14 @@ import struct
 import sys
 from pathlib import Path
 
+import bpy  # noqa: F401  (Blender before the add-on's Blender modules)
 import numpy as np
 
+from autorig_addon.blender.bind_pose import BIND_POSE_TOLERANCE, check_bind_pose
+from autorig_addon.cli.batch import stdout_to_stderr
+from autorig_addon.core.io.scene_formats import scene_files
+
 REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO))
-
-import bpy  # noqa: E402,F401  (Blender before the add-on's Blender modules)
-
-from autorig_addon.blender.bind_pose import BIND_POSE_TOLERANCE, check_bind_pose  # noqa: E402
-from autorig_addon.cli.batch import stdout_to_stderr  # noqa: E402
-from autorig_addon.core.io.scene_formats import scene_files  # noqa: E402
 
 DEFAULT_FOLDER = REPO.parent / "shared" / "data" / "characters"
 

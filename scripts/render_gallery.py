@@ -17,17 +17,13 @@ from __future__ import annotations
 import argparse
 import colorsys
 import os
-import sys
 
+import bpy
+import mathutils
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-
-import bpy  # noqa: E402
-import mathutils  # noqa: E402
-
-from autorig_addon.core.procedural import KINDS, generate_character  # noqa: E402
-from docs_render import bone_sticks  # noqa: E402
+from autorig_addon.core.procedural import KINDS, generate_character
+from docs_render import bone_sticks
 
 #: Image size in pixels (width per character, height).
 CELL_PIXELS = 200

@@ -27,21 +27,25 @@ import os
 import sys
 from functools import lru_cache
 
+import bpy
 import numpy as np
+from mathutils import Vector
+
+from autorig_addon.blender.characters import load_character
+from autorig_addon.core.geometry.bounding_box import largest_side
+from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, predict_votes, skeleton_from_votes
+from docs_render import (
+    CHARACTERS,
+    DOC_CHARACTERS,
+    add_label,
+    mesh_from_arrays,
+    render,
+    save_side_by_side,
+    setup_render,
+    skeleton_objects,
+)
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import bpy  # noqa: E402
-from mathutils import Vector  # noqa: E402
-
-from autorig_addon.blender.characters import load_character  # noqa: E402
-from autorig_addon.core.geometry.bounding_box import largest_side  # noqa: E402
-from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, predict_votes, skeleton_from_votes  # noqa: E402
-from docs_render import (  # noqa: E402
-    CHARACTERS, DOC_CHARACTERS, add_label, mesh_from_arrays, render, save_side_by_side, setup_render, skeleton_objects,
-)
 
 #: Levels of detail of the bandwidth picture, share of the largest side:
 #: finer than the default, the default, coarser.

@@ -16,22 +16,26 @@ import argparse
 import os
 import sys
 
+import bpy
 import numpy as np
+from mathutils import Vector
+
+from autorig_addon.blender.characters import load_character
+from autorig_addon.core.skinning.geometric import geometric_weights
+from autorig_addon.core.skinning.learned.predict import learned_weights
+from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD
+from docs_render import (
+    CHARACTERS,
+    DOC_CHARACTERS,
+    bone_palette,
+    mesh_from_arrays,
+    render,
+    save_side_by_side,
+    set_colors,
+    setup_render,
+)
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import bpy  # noqa: E402
-from mathutils import Vector  # noqa: E402
-
-from autorig_addon.blender.characters import load_character  # noqa: E402
-from autorig_addon.core.skinning.geometric import geometric_weights  # noqa: E402
-from autorig_addon.core.skinning.learned.predict import learned_weights  # noqa: E402
-from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD  # noqa: E402
-from docs_render import (  # noqa: E402
-    CHARACTERS, DOC_CHARACTERS, bone_palette, mesh_from_arrays, render, save_side_by_side, set_colors, setup_render,
-)
 
 
 

@@ -16,20 +16,17 @@ import argparse
 import os
 import sys
 
+import bpy
+from mathutils import Vector
+
+from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights
+from autorig_addon.blender.status_attribute import write_status_attribute
+from autorig_addon.blender.weight_writer import write_weights
+from autorig_addon.core.transfer import transfer_weights
+from autorig_addon.core.transfer.matching import closest_point_weights
+from docs_render import duplicate, heat_colors, render, save_side_by_side, set_colors, set_pose, setup_render
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, REPO)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import bpy  # noqa: E402
-from mathutils import Vector  # noqa: E402
-
-from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights  # noqa: E402
-from autorig_addon.blender.status_attribute import write_status_attribute  # noqa: E402
-from autorig_addon.blender.weight_writer import write_weights  # noqa: E402
-from autorig_addon.core.transfer import transfer_weights  # noqa: E402
-from autorig_addon.core.transfer.matching import closest_point_weights  # noqa: E402
-from docs_render import duplicate, heat_colors, render, save_side_by_side, set_colors, set_pose, setup_render  # noqa: E402
 
 MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 #: Pose used for the comparison: (bone, axis, degrees) in the bone's local frame.

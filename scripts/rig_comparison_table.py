@@ -10,15 +10,12 @@ character with each metric as ``first / second / ...`` in the order given
 """
 
 import json
-import os
 import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-
-from autorig_addon.core.evaluation.report import METRIC_KEYS  # noqa: E402
-from skin_comparison_table import character_table, format_cell  # noqa: E402
+from autorig_addon.core.evaluation.report import METRIC_KEYS
+from skin_comparison_table import character_table, format_cell
 
 METRICS = METRIC_KEYS["rig"]
 #: Metrics where higher is better; lower is better for the others.

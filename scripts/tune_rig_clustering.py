@@ -14,20 +14,15 @@ side; RigNet's metrics, ``core.evaluation``).
 
 from __future__ import annotations
 
-import os
-import sys
-
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from autorig_addon.core.dataset.cache import training_samples  # noqa: E402
-from autorig_addon.core.evaluation.joint_matching import JOINT_MATCH_FRACTION, joint_iou_precision_recall  # noqa: E402
-from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j  # noqa: E402
-from autorig_addon.core.nn.training.rig_run import default_examples_dir  # noqa: E402
-from autorig_addon.core.nn.training.skin_run import HOLDOUT_EVERY  # noqa: E402
-from autorig_addon.core.rigging.predict import cluster_joints, graph_votes, trained_network  # noqa: E402
-from autorig_addon.core.rigging.training_set import load_example  # noqa: E402
+from autorig_addon.core.dataset.cache import training_samples
+from autorig_addon.core.evaluation.joint_matching import JOINT_MATCH_FRACTION, joint_iou_precision_recall
+from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j
+from autorig_addon.core.nn.training.rig_run import default_examples_dir
+from autorig_addon.core.nn.training.skin_run import HOLDOUT_EVERY
+from autorig_addon.core.rigging.predict import cluster_joints, graph_votes, trained_network
+from autorig_addon.core.rigging.training_set import load_example
 
 BANDWIDTHS = (0.01, 0.0125, 0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
 THRESHOLDS = (0.0, 0.01, 0.02, 0.05)
