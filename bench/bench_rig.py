@@ -116,8 +116,10 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as folder:
         if any(size != "5k" for size in args.sizes):
             # Run in bench/, where "-c" finds bench_skinning.
-            child = subprocess.run([sys.executable, "-c", f"import bench_skinning; bench_skinning.write_cache({folder!r})"],
-                                   capture_output=True, text=True, cwd=BENCH)
+            child = subprocess.run(
+                [sys.executable, "-c", f"import bench_skinning; bench_skinning.write_cache({folder!r})"],
+                capture_output=True, text=True, cwd=BENCH,
+            )
             if child.returncode:
                 sys.stderr.write(child.stderr)
                 return 1

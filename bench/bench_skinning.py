@@ -155,8 +155,8 @@ def quality(folder: str) -> None:
         weights, seconds = skin(mesh, skeleton, path)
         results[size, path] = weights.matrix
         m = evaluate_skin(mesh.vertices, weights, reference, skeleton)
-        print(f"| {size} | {PATH_NAMES[path]} | {seconds:.1f} | {m['l1']:.4f} | {m['precision']:.4f} | {m['recall']:.4f} | "
-              f"{m['deform_mean']:.6f} | {m['deform_max']:.4f} |", flush=True)
+        print(f"| {size} | {PATH_NAMES[path]} | {seconds:.1f} | {m['l1']:.4f} | {m['precision']:.4f} | "
+              f"{m['recall']:.4f} | {m['deform_mean']:.6f} | {m['deform_max']:.4f} |", flush=True)
     difference = np.abs(results["53k", "proxy"] - results["53k", "full"])
     print(f"\n53k, default - every vertex: mean |weight difference| {difference.mean():.5f}, 99th percentile of the "
           f"per-vertex largest {np.percentile(difference.max(axis=1), 99):.4f}, largest {difference.max():.4f}")
@@ -200,9 +200,9 @@ def main(argv=None) -> int:
                 return 1
             result = json.loads(child.stdout.strip().splitlines()[-1])
             for path, r in result["paths"].items():
-                print(f"| {size} | {result['vertices']:,} | {result['objects']} | {result['bones']} | {PATH_NAMES[path]} | "
-                      f"{r['median_s']:.2f} | {r['min_s']:.2f} to {r['max_s']:.2f} | {r['added_mib']:.0f} | "
-                      f"{r['total_mib']:.0f} |", flush=True)
+                print(f"| {size} | {result['vertices']:,} | {result['objects']} | {result['bones']} | "
+                      f"{PATH_NAMES[path]} | {r['median_s']:.2f} | {r['min_s']:.2f} to {r['max_s']:.2f} | "
+                      f"{r['added_mib']:.0f} | {r['total_mib']:.0f} |", flush=True)
             if len(result["paths"]) == 2:
                 ratio = result["paths"]["full"]["median_s"] / result["paths"]["proxy"]["median_s"]
                 print(f"| {size} | | | | every vertex / default | **{ratio:.1f}x** | | | |", flush=True)

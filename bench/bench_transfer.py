@@ -73,7 +73,8 @@ def main(argv=None) -> int:
     median_total, median_baseline = statistics.median(totals), statistics.median(baseline)
     print(f"Source: makehuman body, {source.vertex_count} vertices, {len(source.triangles)} triangles, "
           f"{len(source_weights.bone_names)} bones. Target: {args.garment}, {target.vertex_count} vertices, "
-          f"{len(target.triangles)} triangles. {result.summary()}. Median of {args.repeat} runs, {os.cpu_count()} cores.\n")
+          f"{len(target.triangles)} triangles. {result.summary()}. "
+          f"Median of {args.repeat} runs, {os.cpu_count()} cores.\n")
     print("| stage | median s |\n|---|---|")
     for stage, values in stage_times.items():
         print(f"| {stage} | {statistics.median(values):.3f} |")

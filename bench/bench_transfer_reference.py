@@ -54,7 +54,8 @@ import numpy as np, igl
 spec = importlib.util.spec_from_file_location("reference_utils", sys.argv[2])
 reference = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(reference)
-find_matches_closest_surface, inpaint, smooth = reference.find_matches_closest_surface, reference.inpaint, reference.smooth
+find_matches_closest_surface = reference.find_matches_closest_surface
+inpaint, smooth = reference.inpaint, reference.smooth
 arrays = np.load(sys.argv[1])
 V1, F1, W1 = arrays["body_V"], arrays["body_F"], arrays["body_W"]
 times = {}

@@ -103,7 +103,8 @@ def main(argv=None) -> int:
     parser.add_argument("--reversed", action="store_true", help="only the reversed-order case")
     args = parser.parse_args(argv)
     if args.reversed:
-        print(f"reversed order, {REVERSED_GROUPS} groups, {REVERSED_VERTICES} vertices: {time_reversed(args.repeat):.3f} s")
+        print(f"reversed order, {REVERSED_GROUPS} groups, {REVERSED_VERTICES} vertices: "
+              f"{time_reversed(args.repeat):.3f} s")
         return 0
 
     import bpy
@@ -137,7 +138,8 @@ def main(argv=None) -> int:
         banded = np.zeros((len(x), bones))
         for offset in range(4):
             banded[np.arange(len(x)), band + offset] = rng.random(len(x))
-        cases.append((f"grid, {bones} bones", grid, Weights(banded / banded.sum(axis=1, keepdims=True), copied.bone_names)))
+        banded_weights = Weights(banded / banded.sum(axis=1, keepdims=True), copied.bone_names)
+        cases.append((f"grid, {bones} bones", grid, banded_weights))
     writers = {"now": lambda obj, weights: write_weights(obj, weights, plan.armature),
                "before": lambda obj, weights: write_per_value(obj, weights, plan.armature)}
 
@@ -149,7 +151,8 @@ def main(argv=None) -> int:
     bpy.data.objects.remove(warm_up)
 
     print(f"{args.garment}: {copied.vertex_count} vertices; transfer {transfer_seconds:.3f} s")
-    print("| weights | vertices | distinct (group, value) pairs | first write, now / before | again (bound), now / before |")
+    print("| weights | vertices | distinct (group, value) pairs | first write, now / before "
+          "| again (bound), now / before |")
     print("|---|---|---|---|---|")
     for label, original, weights in cases:
         distinct = sum(len(np.unique(column[column > 0])) for column in weights.matrix.astype(np.float32).T)
@@ -171,7 +174,8 @@ def main(argv=None) -> int:
                 bpy.data.objects.remove(target)
                 bpy.data.meshes.remove(mesh)
         assert all(np.array_equal(stored[0], other) for other in stored[1:]), "the writers stored different weights"
-        cells = [" / ".join(f"{statistics.median(times[writer, run]):.3f}" for writer in writers) for run in ("first", "again")]
+        cells = [" / ".join(f"{statistics.median(times[writer, run]):.3f}" for writer in writers)
+                 for run in ("first", "again")]
         print(f"| {label} | {weights.vertex_count} | {distinct} | {cells[0]} s | {cells[1]} s |")
     return 0
 

@@ -89,7 +89,8 @@ def category_of(path: str) -> str:
         return CATEGORY_BY_FILE[path]
     folder = path.rsplit("/", 1)[0]
     if folder not in CATEGORY_BY_FOLDER:
-        raise SystemExit(f"No category for {path}: add its folder to CATEGORY_BY_FOLDER or the file to CATEGORY_BY_FILE.")
+        raise SystemExit(f"No category for {path}: add its folder to CATEGORY_BY_FOLDER or the file to "
+                         "CATEGORY_BY_FILE.")
     return CATEGORY_BY_FOLDER[folder]
 
 
@@ -189,7 +190,8 @@ def main(argv=None) -> int:
     with open(args.output, "w", encoding="utf-8") as handle:
         handle.write(text)
     counts = {c: (sum(p in split["validation"] for p in m), len(m)) for c, m in split["categories"].items()}
-    print(f"wrote {args.output}: {len(split['train'])} train, {len(split['validation'])} validation; per category (validation, total): {counts}")
+    print(f"wrote {args.output}: {len(split['train'])} train, {len(split['validation'])} validation; "
+          f"per category (validation, total): {counts}")
     return 0
 
 

@@ -82,9 +82,11 @@ def render_row(kind, seeds, path, cell_pixels=CELL_PIXELS):
         colours = character.weights.matrix @ bone_colours(character.skeleton.bone_count)
         mesh_object(f"{kind}_{seed}", vertices * scale + offset, character.mesh.triangles, colours)
         deform = character.skeleton.deform
-        stick_vertices, stick_triangles = bone_sticks(character.skeleton.joints[deform] @ TURN.T, character.skeleton.tails[deform] @ TURN.T,
+        stick_vertices, stick_triangles = bone_sticks(character.skeleton.joints[deform] @ TURN.T,
+                                                      character.skeleton.tails[deform] @ TURN.T,
                                                       BONE_STICK_RADIUS / scale)
-        mesh_object(f"{kind}_{seed}_bones", stick_vertices * scale + offset, stick_triangles, np.full((len(stick_vertices), 3), 0.05))
+        mesh_object(f"{kind}_{seed}_bones", stick_vertices * scale + offset, stick_triangles,
+                    np.full((len(stick_vertices), 3), 0.05))
         x += 1.0 + CELL_GAP
     width = x - CELL_GAP
     camera_data = bpy.data.cameras.new("camera")

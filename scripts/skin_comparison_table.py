@@ -1,6 +1,9 @@
 """Markdown comparison of skin evaluation reports (from ``eval skin --out``).
 
-Usage: .venv/bin/python scripts/skin_comparison_table.py out/eval_skin_geometric.json out/eval_skin_boneheat.json out/eval_skin_nearest_bone.json
+Usage::
+
+    .venv/bin/python scripts/skin_comparison_table.py out/eval_skin_geometric.json \\
+        out/eval_skin_boneheat.json out/eval_skin_nearest_bone.json
 
 Prints one row per character with each metric as ``first / second / ...``
 in the order given, then the mean and median over all characters.

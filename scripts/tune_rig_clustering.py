@@ -47,7 +47,8 @@ def main() -> None:
                 scores.append(chamfer_j2j(joints, example.joints))
                 ious.append(joint_iou_precision_recall(joints, example.joints, JOINT_MATCH_FRACTION)["iou"])
                 counts.append(len(joints) / len(example.joints))
-            print(f"| {bandwidth} | {threshold} | {np.mean(scores):.4f} | {np.mean(ious):.3f} | {np.mean(counts):.2f} |")
+            print(f"| {bandwidth} | {threshold} | {np.mean(scores):.4f} | {np.mean(ious):.3f} | "
+                  f"{np.mean(counts):.2f} |")
 
 
 if __name__ == "__main__":
