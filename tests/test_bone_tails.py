@@ -91,7 +91,8 @@ def test_root_branch_goes_to_the_child_with_most_descendants():
 
 def test_mirror_twins_never_continue_a_bone():
     # The neck goes to the head, not to one of the two ears (each with a child).
-    joints = np.array([[0, 0, 0], [0, 0, 1.0], [0, 0.1, 1.3], [0.2, 0, 1.3], [0.3, 0, 1.5], [-0.2, 0, 1.3], [-0.3, 0, 1.5]])
+    joints = np.array([[0, 0, 0], [0, 0, 1.0], [0, 0.1, 1.3], [0.2, 0, 1.3], [0.3, 0, 1.5], [-0.2, 0, 1.3],
+                       [-0.3, 0, 1.5]])
     parents = np.array([-1, 0, 1, 1, 3, 1, 5])
     np.testing.assert_allclose(derived_tails(joints, parents)[1], joints[2])
 
@@ -145,7 +146,8 @@ def test_point_like_armature_gets_derived_tails_and_heads_stay():
     # Every bone with a child ends on the child that continues it: the hips on the spine.
     for j in (0, 1, 2, 3, 5, 7):
         np.testing.assert_allclose(fixed.tails[j], real.tails[j], atol=1e-12)
-    np.testing.assert_allclose(fixed.tails[4], real.joints[4] + LEAF_LENGTH_FRACTION * (real.joints[4] - real.joints[3]))
+    np.testing.assert_allclose(fixed.tails[4],
+                               real.joints[4] + LEAF_LENGTH_FRACTION * (real.joints[4] - real.joints[3]))
     assert decision.whole_armature and decision.derived == real.names
     assert decision.note.startswith("bone tails derived from the joints: the stored bones are point-like")
     assert "0.005 % of the character" in decision.note
@@ -166,7 +168,8 @@ def test_point_like_directions_that_point_at_children_are_kept():
 def test_lone_root_of_a_point_like_armature_points_up():
     skeleton = Skeleton(np.array([[0, 0, 0], [1.0, 0, 0]]), [-1, -1], ("a", "b"), np.array([[0, 0, 0.0], [1.0, 0, 0]]))
     fixed, decision = with_reliable_tails(skeleton, 2.0)
-    np.testing.assert_allclose(fixed.tails, [[0, 0, LONE_ROOT_LENGTH_FRACTION * 2.0], [1.0, 0, LONE_ROOT_LENGTH_FRACTION * 2.0]])
+    np.testing.assert_allclose(fixed.tails,
+                               [[0, 0, LONE_ROOT_LENGTH_FRACTION * 2.0], [1.0, 0, LONE_ROOT_LENGTH_FRACTION * 2.0]])
     assert decision.whole_armature
 
 
@@ -184,14 +187,16 @@ def test_point_like_bone_with_a_child_in_a_real_armature_ends_at_the_child():
     fixed, decision = with_reliable_tails(Skeleton(real.joints, real.parents, real.names, tails), 2.0)
     np.testing.assert_allclose(fixed.tails, real.tails)
     assert decision.derived == ("spine",) and not decision.whole_armature
-    assert "'spine'" in decision.note and decision.note.startswith("bone tails derived from the joints for 1 point-like bone")
+    assert "'spine'" in decision.note
+    assert decision.note.startswith("bone tails derived from the joints for 1 point-like bone")
 
 
 def test_point_like_deform_leaf_in_a_real_armature_is_refused_by_name():
     real = biped()
     tails = real.tails.copy()
     tails[4] = real.joints[4] + [0, 0, 1e-6]
-    with pytest.raises(InputError, match=r"Deform bone 'head' has zero length and no child to point at: give it a length"):
+    with pytest.raises(InputError,
+                       match=r"Deform bone 'head' has zero length and no child to point at: give it a length"):
         with_reliable_tails(Skeleton(real.joints, real.parents, real.names, tails), 2.0)
     # A non-deform leaf (a control) is no obstacle and keeps its tail.
     deform = np.ones(real.bone_count, dtype=bool)

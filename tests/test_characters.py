@@ -69,7 +69,8 @@ def test_load_character_reads_mesh_skeleton_and_weights(clean_scene, tmp_path, e
     # Every vertex of the cylinder lies on it, in world space.
     radial = np.linalg.norm(character.mesh.vertices[:, :2], axis=1)
     assert np.all((np.abs(radial - BODY_RADIUS) < 1e-5) | (radial < 1e-6))
-    np.testing.assert_allclose(character.weights.matrix, expected_body_weights(character.mesh.vertices[:, 2]), atol=1e-5)
+    np.testing.assert_allclose(character.weights.matrix, expected_body_weights(character.mesh.vertices[:, 2]),
+                               atol=1e-5)
     assert character.weights.bone_names == (LOWER_BONE, UPPER_BONE)
     assert character.skeleton.names == (LOWER_BONE, UPPER_BONE)
     np.testing.assert_allclose(character.skeleton.joints, [[0, 0, 0], [0, 0, 1]], atol=1e-5)
@@ -258,6 +259,7 @@ def test_character_samples_are_cached(clean_scene, tmp_path, monkeypatch):
         raise AssertionError("the cached sample should have been used")
 
     monkeypatch.setattr(characters, "load_simplified", must_not_load)
-    second = characters.build_character_samples([path], tmp_path / "cache", 200, root=tmp_path / "chars", split=split)[0]
+    second = characters.build_character_samples([path], tmp_path / "cache", 200, root=tmp_path / "chars",
+                                                split=split)[0]
     np.testing.assert_array_equal(first.vertices, second.vertices)
     np.testing.assert_array_equal(first.weights, second.weights)

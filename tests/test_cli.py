@@ -120,9 +120,11 @@ def test_arguments_from_sys_argv(argv, expected):
     ("arguments", "message"),
     [
         (["transfer", "in.blend"], "error: the following arguments are required: --out, --source"),
-        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--mix", "1.5"], "error: argument --mix: 1.5 is not between 0 and 1"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--mix", "1.5"],
+         "error: argument --mix: 1.5 is not between 0 and 1"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--smoothing-iterations", str(MAX_SMOOTHING_ITERATIONS + 1)],
-         f"error: argument --smoothing-iterations: {MAX_SMOOTHING_ITERATIONS + 1} is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
+         f"error: argument --smoothing-iterations: {MAX_SMOOTHING_ITERATIONS + 1} is not between 0 and "
+         f"{MAX_SMOOTHING_ITERATIONS}"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--smoothing-iterations", "1000000"],
          f"error: argument --smoothing-iterations: 1000000 is not between 0 and {MAX_SMOOTHING_ITERATIONS}"),
         (["skin", "in.blend", *SKIN_ARGUMENTS, "--smoothing-iterations", "1000000"],
@@ -131,14 +133,20 @@ def test_arguments_from_sys_argv(argv, expected):
          f"error: argument --max-influences: -1 is not between 0 and {MAX_INFLUENCES}"),
         (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-normal-angle", "181"],
          "error: argument --max-normal-angle: 181 is not between 0.1 and 180"),
-        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-distance", "0"], "error: argument --max-distance: 0 is not positive"),
-        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--replace", "some"], "error: argument --replace: invalid choice: 'some'"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--max-distance", "0"],
+         "error: argument --max-distance: 0 is not positive"),
+        (["transfer", "in.blend", *TRANSFER_ARGUMENTS, "--replace", "some"],
+         "error: argument --replace: invalid choice: 'some'"),
         (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", str(MAX_RESOLUTION + 1)],
          f"error: argument --resolution: {MAX_RESOLUTION + 1} is not between {MIN_RESOLUTION} and {MAX_RESOLUTION}"),
-        (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", "fine"], "error: argument --resolution: fine is not an integer"),
-        (["skin", "in.blend", *SKIN_ARGUMENTS, "--falloff", "0.05"], "error: argument --falloff: 0.05 is not between 0.1 and 64"),
-        (["skin", "in.blend", *SKIN_ARGUMENTS, "--distance", "euclidean"], "error: argument --distance: invalid choice: 'euclidean'"),
-        (["skin", "in.blend", *SKIN_ARGUMENTS, "--method", "magic"], "error: argument --method: invalid choice: 'magic'"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--resolution", "fine"],
+         "error: argument --resolution: fine is not an integer"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--falloff", "0.05"],
+         "error: argument --falloff: 0.05 is not between 0.1 and 64"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--distance", "euclidean"],
+         "error: argument --distance: invalid choice: 'euclidean'"),
+        (["skin", "in.blend", *SKIN_ARGUMENTS, "--method", "magic"],
+         "error: argument --method: invalid choice: 'magic'"),
     ],
 )
 def test_bad_arguments_exit_2_with_the_reason(arguments, message, capsys):
@@ -194,7 +202,8 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     )
     assert transfer.distance_fraction == pytest.approx(settings.distance_fraction)
     assert transfer.max_normal_angle == pytest.approx(math.degrees(settings.max_normal_angle))
-    assert (transfer.accept_flipped_normals, transfer.smoothing_iterations, transfer.max_influences, transfer.mask_group) == (
+    assert (transfer.accept_flipped_normals, transfer.smoothing_iterations, transfer.max_influences,
+            transfer.mask_group) == (
         settings.accept_flipped_normals, settings.smoothing_iterations, settings.max_influences, settings.mask_group)
     assert transfer.smoothing_strength == pytest.approx(settings.smoothing_strength)
     assert transfer.smoothing_length == pytest.approx(settings.smoothing_length)
@@ -203,7 +212,8 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
                                           ).options.allow_poor_match is True
     skin = parse(["skin", "in.blend", *SKIN_ARGUMENTS])
     assert (skin.distance.upper(), skin.resolution, skin.max_influences, skin.smoothing_iterations) == (
-        settings.skin_distance, settings.skin_resolution, settings.skin_max_influences, settings.skin_smoothing_iterations)
+        settings.skin_distance, settings.skin_resolution, settings.skin_max_influences,
+        settings.skin_smoothing_iterations)
     assert (skin.resolution, skin.distance) == (DEFAULT_RESOLUTION, skinning.DEFAULT_METHOD)
     assert skin.method.upper() == settings.skin_method and skin.method == DEFAULT_SKIN_METHOD
     assert skin.falloff == pytest.approx(settings.skin_falloff) and skin.falloff == skinning.DEFAULT_FALLOFF
@@ -256,7 +266,8 @@ def test_text_progress_draws_the_overall_fraction():
 
 
 def test_transfer_one_blend_file(clean_scene, tmp_path, capsys):
-    source_path, out_path, summary_path = tmp_path / "scene.blend", tmp_path / "out" / "weighted.blend", tmp_path / "summary.json"
+    source_path, out_path = tmp_path / "scene.blend", tmp_path / "out" / "weighted.blend"
+    summary_path = tmp_path / "summary.json"
     sleeve_positions = save_rig_blend(source_path)
 
     code, out, _ = run_main([
@@ -412,7 +423,8 @@ def test_package_unknown_platform_exits_2_before_building(monkeypatch, tmp_path,
     monkeypatch.setattr(packaging, "build_packages", lambda *arguments: pytest.fail("must not build"))
     code, out, err = run_main(["package", "--out", str(tmp_path), "--platform", "linux-arm64"], capsys)
     assert (code, out) == (2, "")
-    assert err == "error: Unknown platform(s) linux-arm64; choose from linux-x64, windows-x64, macos-x64, macos-arm64.\n"
+    assert err == ("error: Unknown platform(s) linux-arm64; choose from linux-x64, windows-x64, macos-x64, "
+                   "macos-arm64.\n")
 
 
 # --------------------------------------------------------------------------- scene files
@@ -422,7 +434,8 @@ def test_scene_io_rejects_unknown_and_missing_files(clean_scene, tmp_path):
     from autorig_addon.blender import scene_io
     from autorig_addon.core.errors import InputError
 
-    with pytest.raises(InputError, match=r"^Cannot read 'scene.usd': use one of \.blend, \.glb, \.gltf, \.fbx, \.obj\.$"):
+    with pytest.raises(InputError,
+                       match=r"^Cannot read 'scene.usd': use one of \.blend, \.glb, \.gltf, \.fbx, \.obj\.$"):
         scene_io.load_scene(tmp_path / "scene.usd")
     with pytest.raises(InputError, match=r"^The file '.*missing\.fbx' does not exist\.$"):
         scene_io.load_scene(tmp_path / "missing.fbx")
@@ -440,7 +453,8 @@ def test_scene_io_fbx_round_trip_and_obj_import(clean_scene, tmp_path):
     body = scene_io.find_object("Body", "MESH")
     assert {LOWER_BONE, UPPER_BONE} <= set(body.vertex_groups.keys())
     assert convert.find_armature(body).type == "ARMATURE"
-    with pytest.raises(InputError, match="'Body' has type Mesh, expected Armature. Available armature objects: Armature"):
+    with pytest.raises(InputError,
+                       match="'Body' has type Mesh, expected Armature. Available armature objects: Armature"):
         scene_io.find_object("Body", "ARMATURE")
 
     (tmp_path / "triangle.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
@@ -482,7 +496,8 @@ def test_a_garment_in_other_units_fails_with_the_factor_unless_allowed(clean_sce
     assert code == 1
     (failed,) = json.loads(out)["failed"]
     assert "'Sleeve' looks 2.54 times too large for 'Body' (inches and centimetres mixed up?)" in failed["error"]
-    assert failed["error"].endswith("To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line).")
+    assert failed["error"].endswith(
+        "To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line).")
     assert not (tmp_path / "refused.blend").exists()
     code, out, _ = run_main([*arguments, "--out", str(tmp_path / "allowed.blend"), "--allow-poor-match"], capsys)
     assert code == 0

@@ -68,10 +68,13 @@ def test_brute_force_agreement_on_random_points():
 
 def test_closest_points_on_a_triangle_cover_every_region():
     a, b, c = np.array([0.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-    points = np.array([[0.2, 0.2, 1.0], [-1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [-0.5, 3.0, 0.0], [0.5, -1.0, 0.0], [-1.0, 0.5, 0.0], [1.0, 1.0, 0.0]])
-    expected = np.array([[0.6, 0.2, 0.2], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]])
+    points = np.array([[0.2, 0.2, 1.0], [-1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [-0.5, 3.0, 0.0], [0.5, -1.0, 0.0],
+                       [-1.0, 0.5, 0.0], [1.0, 1.0, 0.0]])
+    expected = np.array([[0.6, 0.2, 0.2], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5],
+                         [0.0, 0.5, 0.5]])
     count = len(points)
-    _, bary = closest_points_on_triangles(points, np.tile(a, (count, 1)), np.tile(b, (count, 1)), np.tile(c, (count, 1)))
+    _, bary = closest_points_on_triangles(points, np.tile(a, (count, 1)), np.tile(b, (count, 1)),
+                                          np.tile(c, (count, 1)))
     np.testing.assert_allclose(bary, expected, atol=1e-12)
 
 

@@ -219,7 +219,8 @@ def test_read_weights_of_a_bound_mesh_after_write(clean_scene):
 
 def test_read_mesh_gives_the_rest_shape_of_a_posed_skinned_mesh(clean_scene):
     scene = build_rig_scene(with_button=False)
-    rest = local_positions(scene.body) @ np.array(scene.body.matrix_world)[:3, :3].T + np.array(scene.body.matrix_world)[:3, 3]
+    world = np.array(scene.body.matrix_world)
+    rest = local_positions(scene.body) @ world[:3, :3].T + world[:3, 3]
     bone = scene.armature.pose.bones["Upper"]
     bone.rotation_mode = "QUATERNION"
     bone.rotation_quaternion = Quaternion((1, 0, 0), 1.0)

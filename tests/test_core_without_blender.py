@@ -170,10 +170,13 @@ def test_command_line_help_imports_neither_bpy_nor_torch(repository_root):
     script = (
         "import json, sys\n"
         "from autorig_addon.cli.main import main\n"
-        "codes = [main(['--help'])] + [main([name, '--help']) for name in ('transfer', 'skin', 'eval', 'package', 'train')]\n"
-        "print(json.dumps({'codes': codes, 'loaded': sorted(m for m in sys.modules if m.split('.')[0] in ('bpy', 'torch'))}))\n"
+        "names = ('transfer', 'skin', 'eval', 'package', 'train')\n"
+        "codes = [main(['--help'])] + [main([name, '--help']) for name in names]\n"
+        "loaded = sorted(m for m in sys.modules if m.split('.')[0] in ('bpy', 'torch'))\n"
+        "print(json.dumps({'codes': codes, 'loaded': loaded}))\n"
     )
-    result = subprocess.run([sys.executable, "-c", script], cwd=repository_root, capture_output=True, text=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", script], cwd=repository_root, capture_output=True, text=True,
+                            timeout=120)
     assert result.returncode == 0, result.stderr
     outcome = json.loads(result.stdout.strip().splitlines()[-1])
     assert outcome == {"codes": [0, 0, 0, 0, 0, 0], "loaded": []}

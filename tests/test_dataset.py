@@ -125,7 +125,8 @@ def test_normalise_rejects_meshes_without_extent():
 def test_sample_needs_one_weight_row_per_vertex():
     mesh, skeleton = biped(facing_plus_y=False)
     weights = Weights(np.ones((3, 1)), ("Hips",))
-    with pytest.raises(InputError, match=f"'Guy': the weights have 3 rows but the mesh has {mesh.vertex_count} vertices"):
+    with pytest.raises(InputError,
+                       match=f"'Guy': the weights have 3 rows but the mesh has {mesh.vertex_count} vertices"):
         CharacterSample.from_character("Guy", "biped", mesh, skeleton, weights)
 
 
@@ -354,7 +355,8 @@ def test_training_samples_are_the_cached_training_side_only(tmp_path, monkeypatc
     found = dataset.training_samples(tmp_path / "samples", str(tmp_path / "split.json"))
     assert [sample.name for sample in found] == ["a/x", "b/y"]
     monkeypatch.setenv("AUTORIG_CACHE", str(tmp_path))  # the default folder is <cache root>/samples
-    assert [sample.name for sample in dataset.training_samples(split_file=str(tmp_path / "split.json"))] == ["a/x", "b/y"]
+    found = dataset.training_samples(split_file=str(tmp_path / "split.json"))
+    assert [sample.name for sample in found] == ["a/x", "b/y"]
     (tmp_path / "samples" / "2.npz").unlink()
     with pytest.raises(InputError, match=(
         rf"^1 training character\(s\) have no cached sample in '{tmp_path / 'samples'}' \(e\.g\. a/x\); build the "

@@ -44,7 +44,8 @@ BODY_LARGEST_SIDE = max(2 * BODY_RADIUS, BODY_HEIGHT)
 SKELETON = Skeleton([[0, 0, 0], [0, 0, 1]], [-1, 0], (LOWER_BONE, UPPER_BONE), [[0, 0, 1], [0, 0, 2]])
 SKIN_KEYS = {"name", "category", "path", "l1", "precision", "recall", "deform_mean", "deform_max", "unweighted",
              "seconds", "vertices", "reference_unweighted", "notes"}
-RIG_KEYS = {"name", "category", "path", "cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit", "seconds", "notes"}
+RIG_KEYS = {"name", "category", "path", "cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit",
+            "seconds", "notes"}
 NO_ARMATURE = ("No armature in this file deforms a mesh: a rigged character needs a mesh with an Armature modifier "
                "(or armature parenting) and vertex groups.")
 
@@ -67,7 +68,8 @@ def run_eval(arguments, tmp_path, capsys):
     """Run ``eval`` with a JSON report; returns (exit code, report, stdout)."""
     out = tmp_path / "report.json"
     capsys.readouterr()
-    code = evaluate.run(parse(arguments + ["--out", str(out), "--split-file", str(tmp_path / "no_split.json"), "--quiet"]))
+    code = evaluate.run(parse(arguments + ["--out", str(out), "--split-file", str(tmp_path / "no_split.json"),
+                                           "--quiet"]))
     stdout = capsys.readouterr().out
     return code, json.loads(out.read_text()), stdout
 
@@ -199,7 +201,8 @@ def test_rig_from_files_equal_to_the_reference(clean_scene, tmp_path, capsys):
     assert code == 0
     (entry,) = report["characters"]
     assert set(entry) == RIG_KEYS
-    assert (entry["cd_j2j"], entry["cd_j2b"], entry["iou"], entry["precision"], entry["recall"], entry["tree_edit"]) == (
+    assert (entry["cd_j2j"], entry["cd_j2b"], entry["iou"], entry["precision"], entry["recall"],
+            entry["tree_edit"]) == (
         0.0, 0.0, 1.0, 1.0, 1.0, 0)
     _, report, _ = run_eval(["rig", str(tmp_path / "body.blend"), "--method", f"file:{shifted}"], tmp_path, capsys)
     (entry,) = report["characters"]
@@ -228,7 +231,8 @@ def test_transfer_onto_a_sleeve_and_self_transfer(clean_scene, tmp_path, capsys)
     # The sleeve's closest body points lie at its own heights, where the body's
     # weights are linear between rings: the transfer gives the exact blend.
     triangles = np.vstack([sleeve_quads[:, [0, 1, 2]], sleeve_quads[:, [0, 2, 3]]])
-    expected = evaluate_transfer(sleeve_vertices, edges(triangles), expected_body_weights(sleeve_vertices[:, 2]), SKELETON)
+    expected = evaluate_transfer(sleeve_vertices, edges(triangles), expected_body_weights(sleeve_vertices[:, 2]),
+                                 SKELETON)
     assert expected["stretch_max"] > 0.0
     assert garment["stretch_p99"] == pytest.approx(expected["stretch_p99"], rel=1e-4)
     assert garment["stretch_max"] == pytest.approx(expected["stretch_max"], rel=1e-4)
@@ -266,7 +270,8 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
     scene_io.save_scene(tmp_path / "sleeve.blend")
     code, report, _ = run_eval(["transfer", str(tmp_path / "sleeve.blend"), "--method", "robust"], tmp_path, capsys)
     assert code == 1
-    assert report["characters"][0]["error"] == "'sleeve' is not rigged, so it is a garment: give the body with --source."
+    assert report["characters"][0]["error"] == ("'sleeve' is not rigged, so it is a garment: give the body with "
+                                                "--source.")
 
 
 @pytest.mark.parametrize(
@@ -318,7 +323,8 @@ def test_json_on_stdout(clean_scene, tmp_path, capsys):
                                "--split-file", str(tmp_path / "none.json"), "--quiet"]))
     report = json.loads(capsys.readouterr().out)
     assert code == 0
-    assert (report["task"], report["method"], [entry["l1"] for entry in report["characters"]]) == ("skin", "reference", [0.0])
+    assert (report["task"], report["method"],
+            [entry["l1"] for entry in report["characters"]]) == ("skin", "reference", [0.0])
 
 
 def test_baseline_report_is_shown_beside(clean_scene, tmp_path, capsys):

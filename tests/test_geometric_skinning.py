@@ -6,7 +6,6 @@ import re
 
 import numpy as np
 import pytest
-from geometry_fixtures import box_mesh, cylinder, grid, subdivided
 
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.geometry.segments import point_segment_distances
@@ -14,6 +13,7 @@ from autorig_addon.core.skinning import geometric
 from autorig_addon.core.skinning.geometric import geometric_weights, sees_nearest_bone
 from autorig_addon.core.skinning.heat_diffusion import heat_diffusion_weights
 from autorig_addon.core.types import Mesh, Skeleton
+from geometry_fixtures import box_mesh, cylinder, grid, subdivided
 
 
 def two_bone_cylinder():
@@ -156,7 +156,8 @@ def test_an_influence_limit_keeps_each_rows_largest_weights():
     # The kept bones are the two largest of the unlimited row; rows that
     # already had at most two bones are unchanged.
     smallest = unlimited.argmin(axis=1)
-    np.testing.assert_array_equal(limited[np.arange(len(limited)), smallest][np.count_nonzero(unlimited, axis=1) == 3], 0.0)
+    np.testing.assert_array_equal(limited[np.arange(len(limited)), smallest][np.count_nonzero(unlimited, axis=1) == 3],
+                                  0.0)
     two = np.count_nonzero(unlimited, axis=1) <= 2
     np.testing.assert_allclose(limited[two], unlimited[two], atol=1e-12)
 
@@ -205,7 +206,8 @@ def test_weights_do_not_depend_on_scene_scale():
 def test_progress_ends_at_one_and_cancel_stops_the_work():
     mesh, skeleton = two_bone_cylinder()
     reports = []
-    geometric_weights(mesh, skeleton, distances=straight_distances(mesh, skeleton), progress=lambda f, m: reports.append((f, m)))
+    geometric_weights(mesh, skeleton, distances=straight_distances(mesh, skeleton),
+                      progress=lambda f, m: reports.append((f, m)))
     assert reports == [(0.9, "Diffusing bone heat"), (1.0, "Weights done")]
 
     def cancel(fraction, message):
@@ -307,7 +309,8 @@ def test_given_distances_are_averaged_onto_the_proxy(monkeypatch, fine_cylinder_
     weights = geometric_weights(mesh, skeleton, distances=distances, progress=lambda f, m: reports.append(m))
     assert_valid(weights, 2)
     assert np.abs(weights.matrix - full).max() < 0.05
-    assert reports == ["Simplifying the mesh", "Diffusing bone heat", "Carrying the weights to every vertex", "Weights done"]
+    assert reports == ["Simplifying the mesh", "Diffusing bone heat", "Carrying the weights to every vertex",
+                       "Weights done"]
 
 
 def test_a_far_prop_on_a_big_mesh_binds_wholly_to_its_nearest_bone(monkeypatch, fine_cylinder_with_button):

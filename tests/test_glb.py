@@ -20,7 +20,8 @@ BINARY_CHUNK = 0x004E4942  # "BIN"
 def write_glb(path, document: dict, binary: bytes) -> None:
     text = json.dumps(document).encode("utf-8")
     text += b" " * (-len(text) % 4)
-    chunks = GLB_CHUNK_HEADER.pack(len(text), GLB_JSON_CHUNK) + text + GLB_CHUNK_HEADER.pack(len(binary), BINARY_CHUNK) + binary
+    chunks = (GLB_CHUNK_HEADER.pack(len(text), GLB_JSON_CHUNK) + text
+              + GLB_CHUNK_HEADER.pack(len(binary), BINARY_CHUNK) + binary)
     path.write_bytes(GLB_HEADER.pack(GLB_MAGIC, 2, GLB_HEADER.size + len(chunks)) + chunks)
 
 

@@ -1,11 +1,11 @@
 """Bone heat as Blender computes it (the networks' prior), on shapes with known answers."""
 
 import numpy as np
-from geometry_fixtures import cylinder
 
 from autorig_addon.core.distances.hollow_dist import hollow_distances
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.skinning.heat_prior import WEIGHT_LIMIT, heat_prior_weights
+from geometry_fixtures import cylinder
 
 HEADS = np.array([[0, 0, 0.0], [0, 0, 1.0]])
 TAILS = np.array([[0, 0, 1.0], [0, 0, 2.0]])

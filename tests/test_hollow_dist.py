@@ -4,7 +4,6 @@ import re
 
 import numpy as np
 import pytest
-from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, plain_grid, vertex_index
 
 from autorig_addon.core.distances.cell_graph import bone_node_distances
 from autorig_addon.core.distances.hollow_dist import build_hollow_graph, hollow_distances
@@ -17,6 +16,7 @@ from autorig_addon.core.distances.vertex_distances import (
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.types import Mesh
+from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, plain_grid, vertex_index
 
 
 def test_convex_shape_gives_straight_distances():

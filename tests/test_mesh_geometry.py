@@ -95,7 +95,8 @@ def test_laplacian_of_linear_function_vanishes_inside_flat_grid():
 def test_voronoi_mass_of_a_regular_grid_is_each_vertex_dual_cell():
     # Unit squares: the dual cell is 1 inside, 1/2 on an edge, 1/4 at a corner.
     mesh = grid(3, 3, size=2.0)
-    np.testing.assert_allclose(voronoi_mass(mesh.vertices, mesh.triangles), [0.25, 0.5, 0.25, 0.5, 1.0, 0.5, 0.25, 0.5, 0.25])
+    np.testing.assert_allclose(voronoi_mass(mesh.vertices, mesh.triangles),
+                               [0.25, 0.5, 0.25, 0.5, 1.0, 0.5, 0.25, 0.5, 0.25])
 
 
 def test_voronoi_mass_of_a_right_and_an_obtuse_triangle():
@@ -115,7 +116,8 @@ def test_degenerate_triangles_give_the_guarded_finite_operators():
     F = np.array([[0, 1, 2]])
     L = cotangent_laplacian(V, F).toarray()
     cot_end, cot_middle = 2 / (5 * AREA_GUARD), -1 / (2 * AREA_GUARD)
-    np.testing.assert_allclose([L[0, 2], L[0, 1], L[1, 2]], [0.5 * cot_middle, 0.5 * cot_end, 0.5 * cot_end], rtol=1e-12)
+    np.testing.assert_allclose([L[0, 2], L[0, 1], L[1, 2]], [0.5 * cot_middle, 0.5 * cot_end, 0.5 * cot_end],
+                               rtol=1e-12)
     np.testing.assert_allclose(L.sum(axis=1), 0.0, atol=1e-12 * np.abs(L).max())
     np.testing.assert_array_equal(voronoi_mass(V, F), [0.0, 0.0, 0.0])
     # Two coincident corners: the angle between them is read as 90 degrees (cot 0).
@@ -232,7 +234,8 @@ def test_one_smoothing_pass_by_hand():
     values = np.array([[1.0], [0.0], [0.0], [0.0]])
     smoothed = smooth_over_edges(values, quad.triangles, iterations=1, strength=0.5)
     np.testing.assert_allclose(smoothed.ravel(), [0.5, 0.25, 0.25, 1 / 6])
-    only_first = smooth_over_edges(values, quad.triangles, iterations=1, strength=0.5, rows=np.array([True, False, False, False]))
+    only_first = smooth_over_edges(values, quad.triangles, iterations=1, strength=0.5,
+                                   rows=np.array([True, False, False, False]))
     np.testing.assert_allclose(only_first.ravel(), [0.5, 0.0, 0.0, 0.0])
     np.testing.assert_array_equal(values.ravel(), [1, 0, 0, 0])  # the input is left alone
 

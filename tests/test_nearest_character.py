@@ -62,7 +62,8 @@ def test_a_stretched_copy_gets_joints_stretched_by_the_same_factors(pool):
     chosen = nearest_character(world_copy(winged, factors, offset), pool)
     assert chosen.name == "procedural_1"
     bones = winged.skeleton.deform_subset()
-    np.testing.assert_allclose(chosen.skeleton.joints, bones.joints * factors + offset, rtol=0, atol=1e-6 * factors.max())
+    np.testing.assert_allclose(chosen.skeleton.joints, bones.joints * factors + offset, rtol=0,
+                               atol=1e-6 * factors.max())
     np.testing.assert_allclose(chosen.skeleton.tails, bones.tails * factors + offset, rtol=0, atol=1e-6 * factors.max())
 
 

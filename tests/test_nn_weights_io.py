@@ -89,5 +89,6 @@ def test_corrupted_metadata_is_an_input_error(tmp_path):
     path = tmp_path / "broken.npz"
     np.savez(path, **{FORMAT_VERSION_KEY: np.asarray(WEIGHTS_FORMAT_VERSION), METADATA_KEY: np.asarray("{not json"),
                       "a": np.zeros(2)})
-    with pytest.raises(InputError, match=r"broken\.npz is not a network weights file \(unreadable version or metadata: "):
+    with pytest.raises(InputError,
+                       match=r"broken\.npz is not a network weights file \(unreadable version or metadata: "):
         load_weights(str(path))

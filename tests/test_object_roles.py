@@ -86,8 +86,8 @@ def test_skinning_a_selected_prop_on_a_bone_binds_it_wholly_to_that_bone(clean_s
     select_only([armature, body, helmet], active=armature)
     capfd.readouterr()
     assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_resolution=32) == {"FINISHED"}
-    assert ("Info: Skinned 1 mesh(es) to 2 deform bones of 'Armature' with Geometric; 'Helmet' bound wholly to bone 'Upper' "
-            "(it was parented to that bone)." in "".join(capfd.readouterr()))
+    assert ("Info: Skinned 1 mesh(es) to 2 deform bones of 'Armature' with Geometric; 'Helmet' bound wholly to bone "
+            "'Upper' (it was parented to that bone)." in "".join(capfd.readouterr()))
     pose_bone_turned(armature, UPPER_BONE, 0.0)
     assert_bound_wholly_to_upper(armature, helmet, moved, rest)
 
@@ -165,7 +165,8 @@ def test_skin_command_skips_helpers_and_leaves_props_on_bones_rigid(clean_scene,
     bpy.ops.wm.save_as_mainfile(filepath=str(source), copy=True)
     summary = tmp_path / "summary.json"
     out = tmp_path / "skinned.blend"
-    assert main(["skin", str(source), "--out", str(out), "--resolution", "32", "--quiet", "--summary", str(summary)]) == 0
+    assert main(["skin", str(source), "--out", str(out), "--resolution", "32", "--quiet", "--summary",
+                 str(summary)]) == 0
     (entry,) = json.loads(summary.read_text())["succeeded"]
     assert entry["meshes"] == ["Tube"]
     assert entry["notes"] == ["'Helmet' left rigid, parented to bone 'Upper'"]
@@ -183,13 +184,15 @@ def test_default_targets_skip_helpers_and_leave_props_on_bones_rigid(clean_scene
     helpers = [bone_shape(rig.armature), *hidden_helpers()]
     untouched = [helmet, *helpers]
     before = scene_state(untouched)
-    outcomes = run_transfer(rig.body, unbound_meshes(rig.body), TransferSettings(), bpy.context.evaluated_depsgraph_get(),
+    outcomes = run_transfer(rig.body, unbound_meshes(rig.body), TransferSettings(),
+                            bpy.context.evaluated_depsgraph_get(),
                             named=False)
     assert {outcome.target.name: outcome.summary for outcome in outcomes} == {
         "Sleeve": "544 copied, 0 inpainted (0%)", "Helmet": "left rigid, parented to bone 'Upper'"}
     assert scene_state(untouched) == before
     np.testing.assert_allclose(group_weights(rig.sleeve, [LOWER_BONE, UPPER_BONE]),
-                               expected_body_weights(np.array([v.co.z for v in rig.sleeve.data.vertices])), atol=COPY_TOLERANCE)
+                               expected_body_weights(np.array([v.co.z for v in rig.sleeve.data.vertices])),
+                               atol=COPY_TOLERANCE)
 
 
 def test_default_targets_with_only_props_and_helpers_is_refused_unchanged(clean_scene):
@@ -231,9 +234,11 @@ def test_transfer_command_on_a_kaykit_like_file_says_what_it_left_and_changes_no
     bpy.ops.wm.save_as_mainfile(filepath=str(source), copy=True)
     summary = tmp_path / "summary.json"
     out = tmp_path / "out.blend"
-    assert main(["transfer", str(source), "--source", "Body", "--out", str(out), "--quiet", "--summary", str(summary)]) == 1
+    assert main(["transfer", str(source), "--source", "Body", "--out", str(out), "--quiet", "--summary",
+                 str(summary)]) == 1
     (failure,) = json.loads(summary.read_text())["failed"]
-    assert failure["error"] == "Nothing to weight: 'Helmet' (bone 'Upper') is left rigid on its bone. Name the meshes to weight them."
+    assert failure["error"] == ("Nothing to weight: 'Helmet' (bone 'Upper') is left rigid on its bone. Name the meshes "
+                                "to weight them.")
     assert not out.exists()
 
 

@@ -89,7 +89,8 @@ def test_manifest_text_rewrites_only_platforms_and_wheels():
         files = "Import/export rigs"
         """
     )
-    text = packaging.manifest_text(source, ["macos-arm64"], ["a-1.0-py3-none-any.whl", "b-2.0-cp311-cp311-win_amd64.whl"])
+    text = packaging.manifest_text(source, ["macos-arm64"],
+                                   ["a-1.0-py3-none-any.whl", "b-2.0-cp311-cp311-win_amd64.whl"])
     parsed = tomllib.loads(text)
     assert parsed["platforms"] == ["macos-arm64"]
     assert parsed["wheels"] == ["./wheels/a-1.0-py3-none-any.whl", "./wheels/b-2.0-cp311-cp311-win_amd64.whl"]
@@ -105,7 +106,8 @@ def test_manifest_wheel_of_each_platform_is_that_platforms_by_blenders_rules():
     builder = _blender_builder_module()
     platforms = list(packaging.PLATFORM_TARGETS)
     for platform, name in EXPECTED_WHEELS.items():
-        compatible = [p for p in platforms if builder.blender_platform_compatible_with_wheel_platform_from_filepath(p, name)]
+        compatible_with = builder.blender_platform_compatible_with_wheel_platform_from_filepath
+        compatible = [p for p in platforms if compatible_with(p, name)]
         assert compatible == [platform], name
     # Every tag pip may download with maps to the target's own platform too.
     for platform, target in packaging.PLATFORM_TARGETS.items():
@@ -129,7 +131,8 @@ def test_cached_wheel_matches_name_and_exact_version(tmp_path):
 
 def test_pip_failure_is_a_clear_packaging_error(tmp_path):
     missing = packaging.WheelRequest("scipy", "0.0.1")
-    with pytest.raises(packaging.PackagingError, match=r"pip could not download scipy==0\.0\.1 for platform tags win_amd64"):
+    with pytest.raises(packaging.PackagingError,
+                       match=r"pip could not download scipy==0\.0\.1 for platform tags win_amd64"):
         packaging.pip_download(missing, ("win_amd64",), str(tmp_path))
     assert list(tmp_path.iterdir()) == []
 
@@ -143,7 +146,8 @@ def test_every_platform_requests_only_scipy_at_the_installed_version():
 
 
 def test_unknown_platform_is_input_error(tmp_path):
-    with pytest.raises(InputError, match="Unknown platform\\(s\\) linux-arm64; choose from linux-x64, windows-x64, macos-x64, macos-arm64"):
+    with pytest.raises(InputError, match="Unknown platform\\(s\\) linux-arm64; choose from linux-x64, windows-x64, "
+                                         "macos-x64, macos-arm64"):
         packaging.build_packages(str(tmp_path), ["linux-arm64"])
     with pytest.raises(InputError, match="No platform given"):
         packaging.build_packages(str(tmp_path), [])

@@ -128,7 +128,8 @@ def test_random_poses_are_reproducible_and_seed_dependent():
 def test_random_poses_rotate_thirty_percent_with_proper_rotations():
     skeleton = chain_skeleton(10)
     poses = random_poses(skeleton, count=50, seed=3)
-    np.testing.assert_allclose(poses @ np.swapaxes(poses, -1, -2), np.broadcast_to(np.eye(3), (50, 10, 3, 3)), atol=1e-12)
+    np.testing.assert_allclose(poses @ np.swapaxes(poses, -1, -2), np.broadcast_to(np.eye(3), (50, 10, 3, 3)),
+                               atol=1e-12)
     np.testing.assert_allclose(np.linalg.det(poses), 1.0, atol=1e-12)
     turned = ~np.all(np.isclose(poses, np.eye(3), atol=1e-15), axis=(2, 3))
     # 30 % of 10 bones = 3 per pose (an angle of exactly 0 has probability 0).
@@ -180,7 +181,8 @@ def test_lbs_divides_by_the_total_weight():
     vertices = np.array([[1.0, 0.0, 0.0]] * 4)
     weights = [[0.25, 0.25], [0.5, 0.5], [0.3, 0.0], [3.0, 1.0]]
     posed = linear_blend_skinning(vertices, weights, quarter_turn_of_first_of_two())
-    np.testing.assert_allclose(posed, [[0.5, 0.5, 0.0], [0.5, 0.5, 0.0], [0.0, 1.0, 0.0], [0.25, 0.75, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(posed, [[0.5, 0.5, 0.0], [0.5, 0.5, 0.0], [0.0, 1.0, 0.0], [0.25, 0.75, 0.0]],
+                               atol=1e-12)
 
 
 def test_lbs_leaves_vertices_without_weight_at_rest():

@@ -7,8 +7,8 @@ import os
 import numpy as np
 import pytest
 
-from autorig_addon.core.geometry.closest_point import closest_points_on_triangles
 from autorig_addon.core.errors import InputError
+from autorig_addon.core.geometry.closest_point import closest_points_on_triangles
 from autorig_addon.core.procedural import (
     KINDS,
     PART_CLOTH,
@@ -212,15 +212,17 @@ def test_left_and_right_parts_mirror_with_mirrored_weights(samples):
     for character in samples:
         names = character.part_names
         bones = character.skeleton.names
-        swap = [bones.index(b[:-2] + ".R") if b.endswith(".L") else bones.index(b[:-2] + ".L") if b.endswith(".R") else k
-                for k, b in enumerate(bones)]
+        swap = [bones.index(b[:-2] + ".R") if b.endswith(".L") else bones.index(b[:-2] + ".L") if b.endswith(".R")
+                else k for k, b in enumerate(bones)]
         for part, name in enumerate(names):
             if not name.endswith(".L"):
                 continue
             twin = names.index(name[:-2] + ".R")
             left, right = character.parts == part, character.parts == twin
-            np.testing.assert_allclose(character.mesh.vertices[right], character.mesh.vertices[left] * MIRROR, atol=1e-9, rtol=0)
-            np.testing.assert_allclose(character.weights.matrix[right], character.weights.matrix[left][:, swap], atol=1e-12)
+            np.testing.assert_allclose(character.mesh.vertices[right], character.mesh.vertices[left] * MIRROR,
+                                       atol=1e-9, rtol=0)
+            np.testing.assert_allclose(character.weights.matrix[right], character.weights.matrix[left][:, swap],
+                                       atol=1e-12)
 
 
 def test_rigid_accessory_vertices_follow_exactly_one_bone(samples):
@@ -258,7 +260,8 @@ def test_body_vertices_blend_only_a_bone_and_its_parent(samples):
             pairs = np.unique(rows[(rows > 0).sum(axis=1) == 2] > 0, axis=0)
             for row in pairs:
                 a, b = np.flatnonzero(row)
-                assert parents[b] == a or parents[a] == b, (character.part_names[part], character.skeleton.names[a], character.skeleton.names[b])
+                assert parents[b] == a or parents[a] == b, (character.part_names[part], character.skeleton.names[a],
+                                                            character.skeleton.names[b])
 
 
 # --- construction rules with known answers -------------------------------------
@@ -278,7 +281,8 @@ def test_joint_blend_weights_with_parent_and_child():
     joint_arc = np.array([0.0, 2.0])
     weights = joint_blend_weights(np.array([0.0, 0.25, 1.0, 2.0]), joint_arc, 0.25, True, True)
     # Columns: parent, bone, child; half-width 0.25 x 2.0 = 0.5 at each end.
-    np.testing.assert_allclose(weights, [[0.5, 0.5, 0.0], [0.25, 0.75, 0.0], [0.0, 1.0, 0.0], [0.0, 0.5, 0.5]], atol=1e-15)
+    np.testing.assert_allclose(weights, [[0.5, 0.5, 0.0], [0.25, 0.75, 0.0], [0.0, 1.0, 0.0], [0.0, 0.5, 0.5]],
+                               atol=1e-15)
 
 
 def test_closest_point_weights_interpolate_the_body():
@@ -295,7 +299,8 @@ def test_box_has_the_exact_volume_and_corners():
     vertices, triangles = box_geometry(np.array([1.0, 2.0, 3.0]), np.array([0.5, 0.25, 2.0]), np.eye(3))
     assert signed_volume(vertices, triangles) == pytest.approx(8 * 0.5 * 0.25 * 2.0, rel=1e-12)
     corners = vertices[np.abs(vertices[:, 0] - 1.0) > 1e-9]
-    np.testing.assert_allclose(np.abs(corners - [1.0, 2.0, 3.0]), np.tile([0.5, 0.25, 2.0], (len(corners), 1)), atol=1e-12)
+    np.testing.assert_allclose(np.abs(corners - [1.0, 2.0, 3.0]), np.tile([0.5, 0.25, 2.0], (len(corners), 1)),
+                               atol=1e-12)
 
 
 def test_ellipsoid_vertices_lie_on_the_ellipsoid():
@@ -351,14 +356,16 @@ def test_bent_chain_splits_into_two_shells():
 
 
 def test_stacked_weight_blocks_take_the_union_of_bone_names():
-    names, weights = stack_weight_blocks([(("a", "b"), np.array([[0.25, 0.75]])), (("c", "a", "a"), np.array([[0.5, 0.25, 0.25], [1.0, 0.0, 0.0]]))])
+    names, weights = stack_weight_blocks([(("a", "b"), np.array([[0.25, 0.75]])),
+                                          (("c", "a", "a"), np.array([[0.5, 0.25, 0.25], [1.0, 0.0, 0.0]]))])
     # Names in first-seen order; a name repeated within a block adds up.
     assert names == ("a", "b", "c")
     np.testing.assert_array_equal(weights, [[0.25, 0.75, 0.0], [0.5, 0.0, 0.5], [0.0, 0.0, 1.0]])
 
 
 def test_summed_weight_blocks_add_up_by_bone_name():
-    names, weights = sum_weight_blocks([(("a", "b"), np.array([[0.5, 0.25], [0.0, 0.5]])), (("c", "a"), np.array([[0.125, 0.125], [0.5, 0.0]]))])
+    names, weights = sum_weight_blocks([(("a", "b"), np.array([[0.5, 0.25], [0.0, 0.5]])),
+                                        (("c", "a"), np.array([[0.125, 0.125], [0.5, 0.0]]))])
     assert names == ("a", "b", "c")
     np.testing.assert_array_equal(weights, [[0.625, 0.25, 0.125], [0.0, 0.5, 0.5]])
 
@@ -367,7 +374,8 @@ def test_polyline_points_by_arc_length():
     polyline = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 2.0, 0.0]])  # 3 long, a corner at 1
     np.testing.assert_array_equal(cumulative_lengths(polyline), [0.0, 1.0, 3.0])
     np.testing.assert_allclose(resample_polyline(polyline, 4), [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 2, 0]], atol=1e-15)
-    np.testing.assert_allclose(points_at_fractions(polyline, np.array([0.5, 1.0])), [[1.0, 0.5, 0.0], [1.0, 2.0, 0.0]], atol=1e-15)
+    np.testing.assert_allclose(points_at_fractions(polyline, np.array([0.5, 1.0])), [[1.0, 0.5, 0.0], [1.0, 2.0, 0.0]],
+                               atol=1e-15)
 
 
 def test_tapered_and_round_radii():
@@ -417,7 +425,8 @@ def find_character(predicate, kind="biped", seeds=range(200)):
 
 
 def test_cloth_takes_body_weights_at_the_closest_body_point():
-    character = find_character(lambda c: "skirt" in c.part_names and c.part_types[c.part_names.index("skirt")] == PART_CLOTH)
+    character = find_character(lambda c: "skirt" in c.part_names
+                               and c.part_types[c.part_names.index("skirt")] == PART_CLOTH)
     skirt = character.parts == character.part_names.index("skirt")
     trunk = np.isin(character.parts, [character.part_names.index(n) for n in ("torso", "leg.L", "leg.R")])
     triangles = character.mesh.triangles[trunk[character.mesh.triangles[:, 0]]]
@@ -427,7 +436,8 @@ def test_cloth_takes_body_weights_at_the_closest_body_point():
     count = len(triangles)
     best = []
     for point in points:
-        closest, bary = closest_points_on_triangles(np.tile(point, (count, 1)), vertices[triangles[:, 0]], vertices[triangles[:, 1]], vertices[triangles[:, 2]])
+        closest, bary = closest_points_on_triangles(np.tile(point, (count, 1)), vertices[triangles[:, 0]],
+                                                    vertices[triangles[:, 1]], vertices[triangles[:, 2]])
         distance = np.linalg.norm(closest - point, axis=1)
         # Ties (the midline between the legs) average the distinct closest points.
         tied = np.flatnonzero(distance <= distance.min() + 1e-9)
@@ -437,7 +447,8 @@ def test_cloth_takes_body_weights_at_the_closest_body_point():
 
 
 def test_driven_skirt_follows_its_own_bones_outside_the_body():
-    character = find_character(lambda c: "skirt" in c.part_names and c.part_types[c.part_names.index("skirt")] == PART_DRIVEN)
+    character = find_character(lambda c: "skirt" in c.part_names
+                               and c.part_types[c.part_names.index("skirt")] == PART_DRIVEN)
     skirt = character.parts == character.part_names.index("skirt")
     names = character.skeleton.names
     skirt_bones = [k for k, n in enumerate(names) if n.startswith("skirt_")]

@@ -4,11 +4,11 @@ where each vertex lies and from what belongs to which part."""
 
 import numpy as np
 import pytest
-from geometry_fixtures import box_mesh, cylinder, subdivided
 
 from autorig_addon.core.geometry.proxy import COUNT_TOLERANCE, simplified_proxy
 from autorig_addon.core.geometry.topology import edges
 from autorig_addon.core.types import Mesh
+from geometry_fixtures import box_mesh, cylinder, subdivided
 
 RADIUS, HEIGHT = 0.5, 2.0
 

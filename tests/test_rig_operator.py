@@ -56,7 +56,8 @@ def biped(clean_scene):
 def outside_box(points, vertices) -> np.ndarray:
     """(k,) how far each point lies outside the vertices' bounding box, share of its diagonal (0 inside)."""
     low, high = vertices.min(0), vertices.max(0)
-    return np.linalg.norm(np.maximum(low - points, 0) + np.maximum(points - high, 0), axis=1) / np.linalg.norm(high - low)
+    outside = np.maximum(low - points, 0) + np.maximum(points - high, 0)
+    return np.linalg.norm(outside, axis=1) / np.linalg.norm(high - low)
 
 
 def bone_count_at(bandwidth: float) -> int:
@@ -151,7 +152,8 @@ def test_auto_rig_binds_every_vertex(biped):
     assert [(m.type, m.object) for m in biped.modifiers] == [("ARMATURE", armature)]
     assert biped.parent == armature
     # Bound, the armature no longer follows the settings.
-    assert rig.live_note(bpy.context)[0] == "'Biped_rig' is bound to meshes: the settings apply at the next Predict Skeleton"
+    assert rig.live_note(bpy.context)[0] == ("'Biped_rig' is bound to meshes: the settings apply at the next "
+                                             "Predict Skeleton")
 
 
 def test_nothing_selected_is_refused_and_scene_unchanged(biped):

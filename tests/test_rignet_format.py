@@ -199,7 +199,8 @@ def test_write_rejects_what_the_format_cannot_hold():
     chain = Skeleton(np.eye(3)[:2], [-1, 0], ("a", "b"))
     with pytest.raises(InputError, match="missing from the skeleton: z"):
         rignet_rig_text(chain, Weights(np.ones((1, 1)), ("z",)))
-    with pytest.raises(InputError, match=re.escape("Weights contain NaN or infinite values; clean them before writing.")):
+    with pytest.raises(InputError,
+                       match=re.escape("Weights contain NaN or infinite values; clean them before writing.")):
         rignet_rig_text(chain, Weights(np.array([[np.nan, 1.0]]), ("a", "b")))
 
 

@@ -9,7 +9,15 @@ from autorig_addon.blender.operators import rignet
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.io.rignet_rig import read_rignet_rig
 from autorig_addon.core.types import Skeleton
-from blender_fixtures import LOWER_BONE, UPPER_BONE, build_rig_scene, group_weights, make_armature, scene_state, select_only
+from blender_fixtures import (
+    LOWER_BONE,
+    UPPER_BONE,
+    build_rig_scene,
+    group_weights,
+    make_armature,
+    scene_state,
+    select_only,
+)
 
 #: Two joints up z, a root and its child, vertices 0 to 2 skinned.
 TWO_JOINT_RIG = ("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
@@ -142,10 +150,12 @@ def test_export_of_a_mesh_whose_last_vertex_is_unweighted_imports_back_onto_it(c
 
 
 @pytest.mark.parametrize("content, message", [
-    (b"glTF\x02\x00\x00\x00", "'picked.txt' is a binary glTF file, not a RigNet rig: import it with File > Import > glTF 2.0."),
+    (b"glTF\x02\x00\x00\x00",
+     "'picked.txt' is a binary glTF file, not a RigNet rig: import it with File > Import > glTF 2.0."),
     (b"\x89PNG\r\n\x1a\n", "'picked.txt' is not a RigNet rig: it is not text (byte 0x89 at position 0 is not UTF-8)."),
     (b"joints a 0 0 0\njoints b 0 0 1e30\nroot a\nhier a b\n", "Line 2: joint 'b' lies at 0, 0, 1e+30, beyond 1e+06"),
-    (b"joints a 0 0 0\njoints b 0 0 0\nroot a\nhier a b\n", "Line 2: joint 'b' is at the same position as its parent 'a'"),
+    (b"joints a 0 0 0\njoints b 0 0 0\nroot a\nhier a b\n",
+     "Line 2: joint 'b' is at the same position as its parent 'a'"),
     (b"joints a 0 0 0\njoints b 0 0 1\nroot a\nhier a b\nskin 1000000000000 a 1\n",
      "Line 5: vertex index 1000000000000 is larger than any mesh can have"),
 ])

@@ -136,7 +136,8 @@ def test_procedural_biped_names_in_full():
     full, full_mirror = procedural_skeleton("biped", 0, deform_only=False)
     given = dict(zip(full.names, named(full, full_mirror)))
     assert (given["root"], given["heel.02.L"], given["heel.02.R"]) == ("root", "limb.L", "limb.R")
-    assert (given["spine"], given["thigh.L"], given["upper_arm.R"], given["spine.006"]) == ("spine", "thigh.L", "upper_arm.R", "head")
+    assert (given["spine"], given["thigh.L"], given["upper_arm.R"],
+            given["spine.006"]) == ("spine", "thigh.L", "upper_arm.R", "head")
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -161,7 +162,8 @@ def test_lizard_is_a_quadruped_with_three_joint_front_legs():
     assert generate_character(0, "tailed").variant == "lizard"
     given = dict(zip(skeleton.names, named(skeleton, mirror)))
     assert classify_body(skeleton.joints, skeleton.parents, mirror) == QUADRUPED
-    assert [given[n] for n in ("upper_arm.L", "forearm.L", "hand.R")] == ["front_thigh.L", "front_shin.L", "front_foot.R"]
+    assert [given[n] for n in ("upper_arm.L", "forearm.L", "hand.R")] == [
+        "front_thigh.L", "front_shin.L", "front_foot.R"]
     assert [given[n] for n in ("thigh.L", "shin.L", "foot.L")] == ["thigh.L", "shin.L", "foot.L"]
     assert [given[n] for n in ("spine", "spine.002", "spine.003", "head", "tail", "tail.007")] == [
         "spine", "spine.002", "neck", "head", "tail", "tail.007"]
@@ -178,7 +180,8 @@ def test_props_get_structural_names(kind, seed, expected):
 
 
 def test_fish_gets_a_spine_forward_and_a_tail_backward():
-    skeleton, mirror = procedural_skeleton("fish", 0)  # Rigify's shark: spine.003 in the middle, the tail spine.002..spine
+    # Rigify's shark: spine.003 in the middle, the tail spine.002..spine
+    skeleton, mirror = procedural_skeleton("fish", 0)
     given = dict(zip(skeleton.names, named(skeleton, mirror)))
     assert classify_body(skeleton.joints, skeleton.parents, mirror) == OTHER
     assert [given[n] for n in ("spine.003", "spine.008", "spine.004", "spine.002", "spine.001", "spine")] == [
@@ -254,7 +257,8 @@ def test_arm_with_an_extra_joint_before_a_hand_with_five_fingers():
     names = skeleton.names()
     assert [names[k] for k in arm_joints] == ["shoulder.L", "upper_arm.L", "forearm.L", "forearm.001.L", "hand.L"]
     assert [names[k] for k in fingers] == ["thumb.01.L", "f_index.01.L", "f_middle.01.L", "f_ring.01.L", "f_pinky.01.L"]
-    assert [names[k + 2] for k in fingers] == ["thumb.02.L", "f_index.02.L", "f_middle.02.L", "f_ring.02.L", "f_pinky.02.L"]
+    assert [names[k + 2] for k in fingers] == [
+        "thumb.02.L", "f_index.02.L", "f_middle.02.L", "f_ring.02.L", "f_pinky.02.L"]
     assert names[fingers[0] + 1] == "thumb.01.R"
 
 

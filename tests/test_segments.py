@@ -25,7 +25,8 @@ def test_parameters_and_nearest_points_by_hand():
     heads, tails = np.array([[0.0, 0, 0]]), np.array([[4.0, 0, 0]])
     points = np.array([[1.0, 2, 0], [-1, 0, 0], [9, 1, 0]])
     np.testing.assert_allclose(segment_parameters(points, heads, tails)[:, 0], [0.25, 0.0, 1.0])
-    np.testing.assert_allclose(nearest_points_on_segments(points, heads, tails)[:, 0], [[1, 0, 0], [0, 0, 0], [4, 0, 0]])
+    np.testing.assert_allclose(nearest_points_on_segments(points, heads, tails)[:, 0],
+                               [[1, 0, 0], [0, 0, 0], [4, 0, 0]])
 
 
 def test_paired_distances_match_the_diagonal_of_all_pairs():
@@ -33,7 +34,8 @@ def test_paired_distances_match_the_diagonal_of_all_pairs():
     points, heads, tails = rng.normal(size=(6, 3)), rng.normal(size=(6, 3)), rng.normal(size=(6, 3))
     tails[2] = heads[2]
     np.testing.assert_allclose(
-        paired_point_segment_distances(points, heads, tails), np.diag(point_segment_distances(points, heads, tails)), atol=1e-12
+        paired_point_segment_distances(points, heads, tails), np.diag(point_segment_distances(points, heads, tails)),
+        atol=1e-12
     )
 
 

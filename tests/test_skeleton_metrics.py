@@ -20,7 +20,8 @@ from geometry_fixtures import small_humanoid
 
 
 def skeleton(joints, parents, deform=None):
-    return Skeleton(np.asarray(joints, dtype=float), parents, tuple(f"j{k}" for k in range(len(parents))), deform=deform)
+    return Skeleton(np.asarray(joints, dtype=float), parents, tuple(f"j{k}" for k in range(len(parents))),
+                    deform=deform)
 
 
 # --- Chamfer distances ---------------------------------------------------

@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.evaluation.skin_metrics import evaluate_skin, evaluate_transfer, influence_precision_recall, skin_l1
+from autorig_addon.core.evaluation.skin_metrics import (
+    evaluate_skin,
+    evaluate_transfer,
+    influence_precision_recall,
+    skin_l1,
+)
 from autorig_addon.core.skeleton.posing import axis_angle_matrices, random_poses
 from autorig_addon.core.types import Skeleton, Weights
 

@@ -49,7 +49,8 @@ def test_skin_operator_binds_ends_to_their_bones(armature_and_tube, distance):
     import bpy
 
     armature, tube = armature_and_tube
-    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_distance=distance, skin_resolution=40) == {"FINISHED"}
+    assert bpy.ops.autorig.skin_weights(skin_method="GEOMETRIC", skin_distance=distance,
+                                        skin_resolution=40) == {"FINISHED"}
     weights = group_weights(tube, [LOWER_BONE, UPPER_BONE])
     z = np.array([v.co.z for v in tube.data.vertices])
     np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
@@ -193,7 +194,8 @@ def test_write_skin_restores_every_mesh_when_a_later_write_fails(clean_scene, mo
 
     armature = make_armature()
     first, second = unbound_cylinder("First"), unbound_cylinder("Second")
-    plan = skin.plan_skin(armature, [first, second], skin.SkinSettings(resolution=24), bpy.context.evaluated_depsgraph_get())
+    plan = skin.plan_skin(armature, [first, second], skin.SkinSettings(resolution=24),
+                          bpy.context.evaluated_depsgraph_get())
     weights = skin.compute_skin(plan)
     before = scene_state([armature, first, second])
     real_write = skin.write_weights

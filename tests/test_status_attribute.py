@@ -15,7 +15,8 @@ GREY = [0.5, 0.5, 0.5, 1.0]
 
 
 def test_status_colors_per_status_and_grey_for_unknown_values():
-    colours = status_attribute.status_colors([VertexStatus.COPIED, VertexStatus.INPAINTED, VertexStatus.PROTECTED, 6, -1])
+    colours = status_attribute.status_colors([VertexStatus.COPIED, VertexStatus.INPAINTED, VertexStatus.PROTECTED,
+                                              6, -1])
     np.testing.assert_allclose(colours, [GREEN, RED, BLUE, GREY, GREY], atol=1e-7)
     assert colours.dtype == np.float32
 

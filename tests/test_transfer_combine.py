@@ -22,7 +22,8 @@ ALL_BONES = np.array([0, 1, 2])
 
 @pytest.mark.parametrize(
     ("mode", "transferred", "bones", "expected"),
-    [(REPLACE, 3, 3, False), (REPLACE_ALL, 3, 3, False), (MIX, 3, 3, True), (REPLACE, 1, 3, True), (REPLACE_ALL, 2, 3, True)],
+    [(REPLACE, 3, 3, False), (REPLACE_ALL, 3, 3, False), (MIX, 3, 3, True), (REPLACE, 1, 3, True),
+     (REPLACE_ALL, 2, 3, True)],
 )
 def test_existing_weights_matter_for_mixing_and_bone_subsets(mode, transferred, bones, expected):
     assert needs_existing_weights(mode, transferred, bones) is expected

@@ -209,12 +209,16 @@ def test_unusable_inputs_are_refused_with_their_message(body):
         ((source, zero, target), {}, "The source 'mesh' carries no bone weights to transfer."),
         ((source, Weights(weights.matrix[:-1], weights.bone_names), target), {},
          "The source weights do not have one row per source vertex."),
-        ((source, weights, target, TransferOptions(max_normal_angle=0.0)), {}, "The normal angle must lie in (0, 180] degrees."),
+        ((source, weights, target, TransferOptions(max_normal_angle=0.0)), {},
+         "The normal angle must lie in (0, 180] degrees."),
         ((source, weights, target, TransferOptions(distance_fraction=0.0)), {}, "The match distance must be positive."),
         ((source, weights, target, TransferOptions(max_distance=-1.0)), {}, "The match distance must be positive."),
-        ((source, weights, target, TransferOptions(smoothing_strength=2.0)), {}, "Smoothing strength must lie in [0, 1]."),
-        ((source, weights, target), {"inpaint_mask": np.zeros(3, bool)}, f"The inpaint mask has 3 entries for {n} target vertices."),
-        ((source, weights, target), {"protected": np.ones(n, bool)}, "Protected vertices were given without their weights."),
+        ((source, weights, target, TransferOptions(smoothing_strength=2.0)), {},
+         "Smoothing strength must lie in [0, 1]."),
+        ((source, weights, target), {"inpaint_mask": np.zeros(3, bool)},
+         f"The inpaint mask has 3 entries for {n} target vertices."),
+        ((source, weights, target), {"protected": np.ones(n, bool)},
+         "Protected vertices were given without their weights."),
     ]
     for arguments, keywords, message in cases:
         with pytest.raises(InputError, match=f"^{re.escape(message)}$"):
@@ -277,7 +281,8 @@ def test_non_manifold_edge_is_handled_and_reported(body):
     source, weights = body
     target = sleeve()
     a, b = target.triangles[0][[0, 2]]  # the quad diagonal: already shared by two triangles
-    fin_tip = (target.vertices[a] + target.vertices[b]) / 2 + np.array([0.0, 0.0, 0.02]) + 0.3 * target.vertices[a] * [1, 1, 0]
+    fin_tip = ((target.vertices[a] + target.vertices[b]) / 2 + np.array([0.0, 0.0, 0.02])
+               + 0.3 * target.vertices[a] * [1, 1, 0])
     fin = Mesh(np.vstack([target.vertices, fin_tip]), np.vstack([target.triangles, [[a, b, target.vertex_count]]]))
     result = transfer_weights(source, weights, fin)
     assert result.non_manifold_edges == 1
@@ -568,7 +573,8 @@ def test_surface_smoothing_keeps_protected_rows_and_its_length_is_bounded(body):
         transfer_weights(source, weights, target, TransferOptions(smoothing_length=0.06))
 
 
-@pytest.mark.parametrize("iterations, drop, falls_back", [(sparse_solve.MAX_ITERATIONS, sparse_solve.DROP_TOLERANCE, False),
+@pytest.mark.parametrize("iterations, drop, falls_back",
+                         [(sparse_solve.MAX_ITERATIONS, sparse_solve.DROP_TOLERANCE, False),
                                                           (0, 0.5, True)])
 def test_positive_definite_solve_agrees_with_a_complete_factorisation(monkeypatch, iterations, drop, falls_back):
     # The smoothing system of a 30 x 30 grid, 40 right-hand sides (one all

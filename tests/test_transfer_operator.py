@@ -19,9 +19,9 @@ from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.transfer.options import DEFAULT_MASK_GROUP
 from autorig_addon.core.transfer.transfer import VertexStatus
 from blender_fixtures import (
-    COPY_TOLERANCE,
     BLEND_END,
     BLEND_START,
+    COPY_TOLERANCE,
     LOWER_BONE,
     UPPER_BONE,
     RecordingWindowManager,
@@ -146,7 +146,8 @@ def test_faceless_target_fails_before_any_target_is_written(rig):
     # Sleeve comes first and would succeed: it must stay unweighted too.
     assert_refused_unchanged(
         rig, "'Wire' has no faces: it is only vertices or edges. Add faces to it (Edit Mode > Face > Fill) "
-        "or pick a mesh with a surface.", [rig.body, rig.sleeve, rig.armature, wire], source="Body", targets="Sleeve,Wire",
+        "or pick a mesh with a surface.", [rig.body, rig.sleeve, rig.armature, wire], source="Body",
+        targets="Sleeve,Wire",
     )
 
 
@@ -162,11 +163,13 @@ def test_objects_far_apart_are_refused(rig):
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        ({"source": "Body", "targets": "Body"}, "'Body' is both the source and a target: pick a different mesh to weight."),
+        ({"source": "Body", "targets": "Body"},
+         "'Body' is both the source and a target: pick a different mesh to weight."),
         ({"source": "Body,Sleeve", "targets": "Sleeve"},
          "Several sources were given (Body, Sleeve): transfer from one body at a time, or join the body meshes into "
          "one object first."),
-        ({"source": "Nobody", "targets": "Sleeve"}, "There is no object named 'Nobody'. Mesh objects here: Body, Sleeve."),
+        ({"source": "Nobody", "targets": "Sleeve"},
+         "There is no object named 'Nobody'. Mesh objects here: Body, Sleeve."),
         ({"source": "Armature", "targets": "Sleeve"},
          "The source 'Armature' is not a mesh (its type is Armature): pick a mesh object."),
         ({"source": "Body", "targets": "Sleeve", "bones": "Spine"},
@@ -327,7 +330,8 @@ def test_protected_vertices_keep_their_weights(rig):
 
 def test_mix_blends_with_existing_weights(rig):
     preweight_sleeve_upper(rig)
-    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", replace_mode="MIX", mix_factor=0.25) == {"FINISHED"}
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", replace_mode="MIX",
+                                            mix_factor=0.25) == {"FINISHED"}
     # existing (0, 1) * 0.75 + transferred (body weights) * 0.25, everywhere on the tube
     expected = 0.75 * np.array([0.0, 1.0]) + 0.25 * expected_body_weights(tube_heights(rig))
     np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected, atol=1e-3)
@@ -339,7 +343,8 @@ def test_replace_keeps_unrelated_groups_and_replace_all_removes_them(rig):
     assert sorted(g.name for g in rig.sleeve.vertex_groups) == [LOWER_BONE, "Pin", UPPER_BONE]
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", replace_mode="REPLACE_ALL") == {"FINISHED"}
     assert sorted(g.name for g in rig.sleeve.vertex_groups) == [LOWER_BONE, UPPER_BONE]
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)),
+                               atol=COPY_TOLERANCE)
 
 
 def test_bone_subset_only_changes_chosen_bones(rig):
@@ -362,7 +367,8 @@ def test_selected_pose_bones_subset(rig):
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", bone_subset="SELECTED") == {"FINISHED"}
     z = tube_heights(rig)
     lower_end = z < BLEND_START - 0.05
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)][lower_end], [[0.5, 0.5]] * int(lower_end.sum()), atol=1e-6)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)][lower_end], [[0.5, 0.5]] * int(lower_end.sum()),
+                               atol=1e-6)
 
 
 def test_running_again_with_new_options_replaces_cleanly(rig):
@@ -449,7 +455,8 @@ def test_skin_panel_draws_every_skin_setting_and_the_button(rig):
 
     select_only([rig.armature, rig.sleeve], active=rig.armature)
     log = []
-    VIEW3D_PT_autorig_skin.draw_settings(SimpleNamespace(), RecordingLayout(log), bpy.context.scene.autorig, bpy.context)
+    VIEW3D_PT_autorig_skin.draw_settings(SimpleNamespace(), RecordingLayout(log), bpy.context.scene.autorig,
+                                         bpy.context)
     assert {name for kind, name in log if kind == "prop"} == set(SKIN_OPTION_NAMES)
     assert ("operator", "autorig.skin_weights") in log
     assert ("label", f"Sleeve to {rig.armature.name}") in log
@@ -492,7 +499,8 @@ def test_a_stray_vertex_on_the_source_changes_nothing(rig, capfd):
     # The source's stray keeps its own weight.
     stray = len(rig.body.data.vertices) - 1
     np.testing.assert_allclose(convert.read_weights(rig.body, BONES).matrix[stray], [1.0, 0.0])
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)),
+                               atol=COPY_TOLERANCE)
 
 
 @pytest.mark.parametrize("which", ["Body", "Sleeve"])
@@ -511,7 +519,8 @@ def test_transfer_works_in_weight_paint_and_pose_mode(rig):
     bpy.ops.object.mode_set(mode="WEIGHT_PAINT")
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
     assert rig.sleeve.mode == "WEIGHT_PAINT"
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)),
+                               atol=COPY_TOLERANCE)
     bpy.ops.object.mode_set(mode="OBJECT")
     rig.sleeve.vertex_groups.clear()
     # The armature in Pose Mode and posed: weights still come from the rest shape.
@@ -519,7 +528,8 @@ def test_transfer_works_in_weight_paint_and_pose_mode(rig):
     bpy.ops.object.mode_set(mode="POSE")
     rig.armature.pose.bones[UPPER_BONE].rotation_quaternion = (0.7071068, 0.7071068, 0.0, 0.0)
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
-    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)), atol=COPY_TOLERANCE)
+    np.testing.assert_allclose(sleeve_weights(rig)[tube(rig)], expected_body_weights(tube_heights(rig)),
+                               atol=COPY_TOLERANCE)
     bpy.ops.object.mode_set(mode="OBJECT")
 
 

@@ -4,7 +4,6 @@ import re
 
 import numpy as np
 import pytest
-from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, vertex_index
 
 from autorig_addon.core.distances.bone_distances import voxelize_covering_bones
 from autorig_addon.core.distances.interior import fill_interior
@@ -13,6 +12,7 @@ from autorig_addon.core.distances.volumetric_geodesic import OUTSIDE_JUMP_PENALT
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.types import Mesh
+from geometry_fixtures import BAD_BONES, body_with_hat, box_mesh, cylinder, vertex_index
 
 
 def u_tube() -> Mesh:

@@ -33,7 +33,6 @@ from autorig_addon.core.errors import InputError
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh, plain_grid
 
-
 # --------------------------------------------------------------------------
 # Voxelisation and filling
 # --------------------------------------------------------------------------
@@ -255,7 +254,8 @@ def test_merge_cells_groups_each_class_of_a_two_cell_block():
     assert (nodes.cell_node[3] == -1).all()
     first = nodes.cell_node[0, 0, 0]
     # Centre of the 7 class-1 cells of the first block.
-    np.testing.assert_allclose(nodes.centres[first], [(0.5 * 4 + 1.5 * 3) / 7, (0.5 * 3 + 1.5 * 4) / 7, (0.5 * 3 + 1.5 * 4) / 7])
+    np.testing.assert_allclose(nodes.centres[first],
+                               [(0.5 * 4 + 1.5 * 3) / 7, (0.5 * 3 + 1.5 * 4) / 7, (0.5 * 3 + 1.5 * 4) / 7])
     np.testing.assert_allclose(nodes.centres[nodes.cell_node[2, 0, 0]], [2.5, 1.0, 1.0])
     pairs = {tuple(sorted(p)) for p in neighbour_node_pairs(nodes)}
     assert len(pairs) == 3  # all three nodes touch each other
@@ -302,14 +302,17 @@ def test_shortest_paths_on_a_hand_checked_l_corridor():
     assert {tuple(p) for p in pairs} == expected_pairs
     # A point-like bone at the first node's centre.
     bone_point = grid.origin + np.array([1.0, 1.0, 1.0]) * grid.cell_size
-    graph = assemble_bone_graph(grid, nodes, pairs, None, 0.0, (np.array([0]), np.array([index[0]]), np.array([0.0])), 1)
+    graph = assemble_bone_graph(grid, nodes, pairs, None, 0.0,
+                                (np.array([0]), np.array([index[0]]), np.array([0.0])), 1)
     distances = bone_node_distances(graph, np.array(index))[:, 0]
     h, diagonal = grid.cell_size, 2 * np.sqrt(2)
-    np.testing.assert_allclose(distances, np.array([0, 2, 4, 6, 4 + diagonal, 6 + diagonal, 8 + diagonal]) * h, atol=1e-8)
+    np.testing.assert_allclose(distances, np.array([0, 2, 4, 6, 4 + diagonal, 6 + diagonal, 8 + diagonal]) * h,
+                               atol=1e-8)
     # A vertex at the far end, half a cell beyond the last node centre.
     vertex = grid.origin + np.array([[7.0, 7.5, 1.0]]) * h
     candidates, query = vertex_cell_candidates(graph, vertex)
-    vertex_distance, layers = combine_vertex_distances(graph, vertex, candidates, query, bone_node_distances(graph, query))
+    vertex_distance, layers = combine_vertex_distances(graph, vertex, candidates, query,
+                                                       bone_node_distances(graph, query))
     assert vertex_distance[0, 0] == pytest.approx((8 + diagonal + 0.5) * h)
     assert layers[0, 0] == 0
     assert np.linalg.norm(vertex - bone_point) < vertex_distance[0, 0]
