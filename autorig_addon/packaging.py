@@ -4,7 +4,7 @@ The add-on's sources are ``autorig_addon/`` while ``blender_manifest.toml``
 sits at the repository top, so a build stages a temporary directory::
 
     STAGE/__init__.py, core/, blender/, ...   contents of autorig_addon/ (less the
-                                              torch-only core/nn/training/)
+                                              training package, training/)
     STAGE/blender_manifest.toml               platforms + wheels rewritten
     STAGE/LICENSE                             the GPL-3.0 text
     STAGE/wheels/*.whl                        the dependencies Blender lacks (scipy)
@@ -16,8 +16,8 @@ builds reuse. Where each platform's wheels come from is spelled out in
 :data:`PLATFORM_TARGETS`; docs/packaging.md explains it for people.
 
 torch is never shipped: inside Blender the networks run on numpy
-(``core/nn``), and torch only trains them (``core/nn/training``, left out
-of the zip).
+(``core/nn``), and torch only trains them (``training/``, left out of the
+zip).
 
 Run ``python -m autorig_addon.packaging OUT_DIR [PLATFORM ...]`` from a
 source checkout. Nothing here imports ``bpy``.
@@ -42,7 +42,6 @@ from pathlib import Path
 from typing import Optional, Sequence
 
 from .core.errors import InputError
-from .core.nn import TRAINING_PACKAGE
 from .core.progress import ProgressCallback, report
 
 #: The add-on package directory; its contents become the extension's root.
@@ -65,8 +64,9 @@ SHIPPED_DISTRIBUTIONS = ("scipy",)
 #: Default download cache, reused between builds (one sub-folder per platform).
 DEFAULT_WHEEL_CACHE = os.path.join("~", ".cache", "autorig_addon", "wheels")
 #: Add-on folders (relative to ``autorig_addon/``) left out of the extension:
-#: the torch-only training code, which nothing inside Blender imports.
-EXCLUDED_SOURCE_FOLDERS = (TRAINING_PACKAGE.replace(".", "/"),)
+#: the training package (torch, training sets, the ``train`` command), which
+#: nothing inside Blender imports.
+EXCLUDED_SOURCE_FOLDERS = ("training",)
 
 
 class PackagingError(InputError):

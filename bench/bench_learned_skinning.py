@@ -25,7 +25,8 @@ import tempfile
 import time
 
 from autorig_addon.core.skinning.geometric import geometric_weights
-from autorig_addon.core.skinning.learned.predict import NETWORK_NAMES, learned_weights
+from autorig_addon.core.skinning.learned.networks import NETWORK_NAMES
+from autorig_addon.core.skinning.learned.predict import learned_weights
 from bench_skinning import character, write_cache
 from memory import _status_mib, peak_rss_added
 

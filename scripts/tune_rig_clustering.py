@@ -19,20 +19,21 @@ import numpy as np
 from autorig_addon.core.dataset.cache import training_samples
 from autorig_addon.core.evaluation.joint_matching import JOINT_MATCH_FRACTION, joint_iou_precision_recall
 from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j
-from autorig_addon.core.nn.training.rig_run import default_examples_dir
-from autorig_addon.core.nn.training.skin_run import HOLDOUT_EVERY
-from autorig_addon.core.rigging.predict import cluster_joints, graph_votes, trained_network
-from autorig_addon.core.rigging.training_set import load_example
+from autorig_addon.core.nn.spec import shipped_weights
+from autorig_addon.core.rigging.networks import joints as joint_network
+from autorig_addon.core.rigging.predict import cluster_joints, graph_votes
+from autorig_addon.training.rigging.train import default_examples_dir
+from autorig_addon.training.rigging.training_set import load_example
+from autorig_addon.training.runs import held_out_names
 
 BANDWIDTHS = (0.01, 0.0125, 0.015, 0.0175, 0.02, 0.0225, 0.025, 0.03, 0.035, 0.04, 0.05)
 THRESHOLDS = (0.0, 0.01, 0.02, 0.05)
 
 
 def main() -> None:
-    names = sorted(sample.name for sample in training_samples())
-    held = names[::HOLDOUT_EVERY]
+    held = sorted(held_out_names([sample.name for sample in training_samples()]))
     folder = default_examples_dir(0)
-    weights = trained_network("joints")
+    weights = shipped_weights(joint_network.SPEC).weights
     votes = []
     for name in held:
         example = load_example(folder / f"{name.replace('/', '__')}#0.npz")

@@ -26,19 +26,18 @@ from pathlib import Path
 
 import numpy as np
 
-if __name__ == "__main__":
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from autorig_addon.core.dataset.normalise import normalise  # noqa: E402
-from autorig_addon.core.dataset.sample import CharacterSample  # noqa: E402
-from autorig_addon.core.procedural import generate_character  # noqa: E402
-from autorig_addon.core.rigging import predict as rig_predict  # noqa: E402
-from autorig_addon.core.rigging.connectivity import (  # noqa: E402
-    bone_probabilities, candidate_pairs, pair_features, root_features, root_scores,
-)
-from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth  # noqa: E402
-from autorig_addon.core.rigging.joint_network import joint_outputs  # noqa: E402
-from autorig_addon.core.skinning.learned import predict as skin_predict  # noqa: E402
+from autorig_addon.core.dataset.normalise import normalise
+from autorig_addon.core.dataset.sample import CharacterSample
+from autorig_addon.core.nn.numpy_kernels import NUMPY, sigmoid
+from autorig_addon.core.nn.spec import shipped_weights
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict as rig_predict
+from autorig_addon.core.rigging.connectivity import bone_probabilities, root_scores
+from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth
+from autorig_addon.core.rigging.networks import joints
+from autorig_addon.core.rigging.tree_features import candidate_pairs, pair_features, root_features
+from autorig_addon.core.skinning.learned import predict as skin_predict
+from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
 
 NETWORK_OUTPUTS_FILE = Path(__file__).resolve().parent / "data" / "network_outputs.npz"
 #: The procedural character every network runs on (a 30-bone chain of 762 vertices).
@@ -48,7 +47,6 @@ BIPED_SEED = 23
 #: Voxel resolution of the distances and depths (the default 96 is slower and
 #: changes nothing these records check).
 RESOLUTION = 32
-SKIN_NETWORKS = ("rignet", "heterskinnet", "skinningnet")
 
 
 def sample_of(seed: int) -> CharacterSample:
@@ -62,11 +60,10 @@ def skin_outputs() -> dict:
     sample = sample_of(SKIN_SEED)
     normalised = normalise(sample.mesh, sample.skeleton.deform_subset())
     arrays = {}
-    for name in SKIN_NETWORKS:
-        distance = skin_predict.network_distance(name)
-        graph = skin_predict.network_graph(normalised.mesh, normalised.skeleton, distance,
-                                           prior=skin_predict.NETWORK_PRIORS[name], resolution=RESOLUTION)
-        arrays[f"skin.{name}.candidates"] = skin_predict.network_candidate_weights(name, graph).astype(np.float32)
+    for name, spec in SKIN_NETWORKS.items():
+        graph = skin_predict.network_graph(normalised.mesh, normalised.skeleton, spec.distance, prior=spec.prior,
+                                           resolution=RESOLUTION)
+        arrays[f"skin.{name}.candidates"] = skin_predict.network_candidate_weights(spec, graph).astype(np.float32)
         weights = skin_predict.learned_weights(sample.mesh, sample.skeleton, name, resolution=RESOLUTION)
         arrays[f"skin.{name}.weights"] = weights.matrix.astype(np.float32)
     return arrays
@@ -79,16 +76,16 @@ def rig_outputs() -> dict:
     mesh = sample_of(SKIN_SEED).mesh
     solid = solid_depth(mesh, RESOLUTION)
     graph = joint_graph(mesh, solid)
-    offsets, attention = joint_outputs(rig_predict.trained_network("joints"), graph)
-    votes = rig_predict.graph_votes(rig_predict.trained_network("joints"), graph, solid)
-    joints, mirror = rig_predict.cluster_joints(votes, rig_predict.DEFAULT_BANDWIDTH, 0.0, True)
-    pairs = candidate_pairs(joints)
+    weights = shipped_weights(joints.SPEC).weights
+    offsets, logits = joints.SPEC.forward(NUMPY, weights, graph)
+    votes = rig_predict.graph_votes(weights, graph, solid)
+    found, mirror = rig_predict.cluster_joints(votes, rig_predict.DEFAULT_BANDWIDTH, 0.0, True)
+    pairs = candidate_pairs(found)
     return {
         "joints.offsets": offsets.astype(np.float32),
-        "joints.attention": attention.astype(np.float32),
-        "bones.probabilities": bone_probabilities(rig_predict.trained_network("bones"),
-                                                  pair_features(joints, pairs, solid, mirror)).astype(np.float32),
-        "root.scores": root_scores(rig_predict.trained_network("root"), root_features(joints, solid)).astype(np.float32),
+        "joints.attention": sigmoid(logits).astype(np.float32),
+        "bones.probabilities": bone_probabilities(pair_features(found, pairs, solid, mirror)).astype(np.float32),
+        "root.scores": root_scores(root_features(found, solid)).astype(np.float32),
     }
 
 

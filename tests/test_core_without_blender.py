@@ -1,12 +1,12 @@
 """Import guards: ``autorig_addon.core`` never loads Blender, and nothing the
 add-on loads when Blender registers it loads torch.
 
-torch is for training only: the torch-importing modules are exactly those
-of the training sub-package ``autorig_addon.core.nn.training``
-(``autorig_addon.core.nn.TRAINING_PACKAGE``). Every other module must import
-without torch, must not name torch or the training package in any import
-(a lazy import inside a function included), and the extension zip leaves
-the training package out.
+torch is for training only: the torch-importing modules are those of the
+training package ``autorig_addon.training``, which imports from ``core``
+and never the reverse. Every module Blender may load (``core``,
+``blender``) must import without torch and must not name torch or the
+training package in any import (a lazy import inside a function included),
+and the extension zip leaves the training package out.
 
 Each import check runs in a fresh interpreter, so modules this test session
 already imported cannot hide an import.
@@ -20,10 +20,12 @@ import sys
 from pathlib import Path
 
 from autorig_addon import packaging
-from autorig_addon.core.nn import TRAINING_PACKAGE
 
-#: The torch-only sub-package, as an absolute module name.
-TRAINING_MODULE = "autorig_addon." + TRAINING_PACKAGE
+#: The training package, as an absolute module name (the one folder the zip leaves out).
+TRAINING_MODULE = "autorig_addon.training"
+#: Its modules that need numpy alone (training sets built without torch).
+NUMPY_TRAINING_MODULES = ("autorig_addon.training.rigging.training_set",
+                          "autorig_addon.training.skinning.learned.training_set")
 
 # Imports every module of some packages, recursively, except the skipped
 # sub-packages (not even their __init__), then prints which of the watched
@@ -67,28 +69,28 @@ def import_everything(repository_root, packages, watched, register=False, skippe
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
-def test_every_core_module_imports_without_bpy(repository_root):
-    # The training modules too, where torch is installed to import them.
+def test_every_core_and_training_module_imports_without_bpy(repository_root):
+    # The training modules where torch is installed to import them (the torch-free pass leaves them out).
     torch_present = importlib.util.find_spec("torch") is not None
-    outcome = import_everything(repository_root, ["autorig_addon.core"], ["bpy", "mathutils", "bmesh"],
-                                skipped=() if torch_present else (TRAINING_MODULE,))
+    packages = ["autorig_addon.core"] + ([TRAINING_MODULE] if torch_present else [])
+    outcome = import_everything(repository_root, packages, ["bpy", "mathutils", "bmesh"])
     assert outcome["loaded"] == []
     # The walk reached the sub-packages' modules, not only the top level.
     assert {"autorig_addon.core.transfer.transfer", "autorig_addon.core.transfer.options",
             "autorig_addon.core.transfer.combine", "autorig_addon.core.weights",
-            "autorig_addon.core.errors", "autorig_addon.core.nn.graph"} <= set(outcome["modules"])
+            "autorig_addon.core.errors", "autorig_addon.core.nn.graph",
+            "autorig_addon.core.skinning.learned.networks.heterskinnet"} <= set(outcome["modules"])
     if torch_present:
-        assert TRAINING_MODULE + ".aggregation" in outcome["modules"]
+        assert {TRAINING_MODULE + ".nn.torch_kernels", TRAINING_MODULE + ".rigging.train"} <= set(outcome["modules"])
 
 
 def test_core_blender_and_register_never_import_torch(repository_root):
     outcome = import_everything(repository_root, ["autorig_addon.core", "autorig_addon.blender"], ["torch"],
-                                register=True, skipped=(TRAINING_MODULE,))
+                                register=True)
     assert outcome["loaded"] == []
     assert {"autorig_addon.blender.operators.transfer", "autorig_addon.blender.ui.properties",
             "autorig_addon.blender.ui.panels", "autorig_addon.core.nn.aggregation",
             "autorig_addon.core.nn.weights_io"} <= set(outcome["modules"])
-    # Only the training package was left out.
     assert not [name for name in outcome["modules"] if name.startswith(TRAINING_MODULE)]
 
 
@@ -139,27 +141,30 @@ def test_no_module_outside_training_names_torch_or_the_training_package(reposito
 def test_import_scan_resolves_relative_imports(tmp_path):
     # The scan above must see a lazy relative import of the training package.
     module = tmp_path / "layers.py"
-    module.write_text("def f():\n    from .training import aggregation\n    import torch.nn\n")
+    module.write_text("def f():\n    from ...training.nn import fit\n    import torch.nn\n")
     names = imported_modules(module, "autorig_addon.core.nn.layers")
-    assert {TRAINING_MODULE, TRAINING_MODULE + ".aggregation", "torch.nn"} <= names
+    assert {TRAINING_MODULE + ".nn", TRAINING_MODULE + ".nn.fit", "torch.nn"} <= names
     names = imported_modules(module, "autorig_addon.core.nn.sub.layers")
-    assert "autorig_addon.core.nn.sub.training" in names
+    assert "autorig_addon.core.training.nn" in names
 
 
 def test_the_extension_leaves_the_training_package_out(tmp_path):
+    assert "autorig_addon." + packaging.EXCLUDED_SOURCE_FOLDERS[0] == TRAINING_MODULE
     packaging.copy_addon_sources(str(tmp_path))
     assert (tmp_path / "core" / "nn" / "graph.py").is_file()
     assert (tmp_path / "core" / "nn" / "__init__.py").is_file()
-    assert not (tmp_path / "core" / "nn" / "training").exists()
+    assert not (tmp_path / "training").exists()
     shipped = {path.relative_to(tmp_path).as_posix() for path in tmp_path.rglob("*.py")}
     sources = {path.relative_to(packaging.ADDON_DIR).as_posix() for path in packaging.ADDON_DIR.rglob("*.py")}
-    assert sources - shipped == {name for name in sources if name.startswith("core/nn/training/")}
+    assert sources - shipped == {name for name in sources if name.startswith("training/")}
+    assert {"training/command.py", "training/nn/fit.py"} <= sources - shipped
     assert not list(tmp_path.rglob("__pycache__"))
 
 
-def test_the_training_package_itself_imports_without_torch(repository_root):
-    # Listing the package (its __init__) must not load torch.
-    script = f"import json, sys, {TRAINING_MODULE}; print(json.dumps('torch' in sys.modules))"
+def test_the_training_package_and_its_training_sets_import_without_torch(repository_root):
+    # Listing the package (its __init__) must not load torch, nor building training examples.
+    script = (f"import json, sys, {TRAINING_MODULE}, {', '.join(NUMPY_TRAINING_MODULES)}; "
+              "print(json.dumps('torch' in sys.modules))")
     result = subprocess.run([sys.executable, "-c", script], cwd=repository_root, capture_output=True, text=True,
                             timeout=120)
     assert result.returncode == 0, result.stderr

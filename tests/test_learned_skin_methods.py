@@ -21,7 +21,8 @@ from autorig_addon.cli import skin as cli_skin
 from autorig_addon.core.errors import Cancelled, InputError
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.skinning import geometric
-from autorig_addon.core.skinning.learned.predict import MIN_DEFORM_BONES, NETWORK_NAMES, learned_weights
+from autorig_addon.core.skinning.learned.networks import NETWORK_NAMES, SKIN_NETWORKS
+from autorig_addon.core.skinning.learned.predict import learned_weights
 from autorig_addon.core.skinning.methods import (
     DEFAULT_SKIN_METHOD,
     GEOMETRIC,
@@ -51,8 +52,8 @@ MAX_INFLUENCES = 2
 CHARACTER_SEED, CHARACTER_KIND = 3, "biped"
 #: What every refusal of an unknown method says.
 #: The methods that weight a two-bone skeleton (RigNet's network needs as
-#: many deform bones as it has candidates, MIN_DEFORM_BONES).
-TWO_BONE_METHODS = tuple(m for m in SKIN_METHODS if MIN_DEFORM_BONES.get(m, 1) <= 2)
+#: many deform bones as it has candidates, its spec's min_deform_bones).
+TWO_BONE_METHODS = tuple(m for m in SKIN_METHODS if m not in SKIN_NETWORKS or SKIN_NETWORKS[m].min_deform_bones <= 2)
 TWO_BONE_NETWORKS = tuple(m for m in NETWORK_NAMES if m in TWO_BONE_METHODS)
 RIGNET_TOO_FEW_BONES = ("rignet needs at least 5 deform bones and the armature has 2: use heterskinnet, skinningnet "
                         "or geometric for so small a skeleton.")

@@ -4,8 +4,9 @@ torch's Adam with a cosine schedule called by hand, so seeded runs reproduce."""
 import pytest
 
 torch = pytest.importorskip("torch")
+pytestmark = pytest.mark.torch
 
-from autorig_addon.core.nn.training.optimisation import WEIGHT_DECAY, CosineAdam  # noqa: E402
+from autorig_addon.training.nn.optimisation import WEIGHT_DECAY, CosineAdam  # noqa: E402
 
 STEPS = 5
 LEARNING_RATE = 0.1

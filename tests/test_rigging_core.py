@@ -16,9 +16,9 @@ from autorig_addon.core.errors import InputError
 from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j, evaluate_rig
 from autorig_addon.core.geometry.bounding_box import largest_side
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging import connectivity, mean_shift, predict, symmetry
+from autorig_addon.core.rigging import connectivity, mean_shift, predict, symmetry, tree_features
 from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
-from autorig_addon.core.rigging.training_set import joint_targets
+from autorig_addon.training.rigging.training_set import joint_targets
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh, cylinder
@@ -206,7 +206,7 @@ FIGURE_BONES = {(0, 1), (1, 2), (1, 3), (1, 4), (3, 5), (4, 6), (0, 7), (0, 8), 
 def test_candidate_pairs_are_unique_ordered_and_hold_each_nearest_neighbour():
     rng = np.random.default_rng(6)
     joints = rng.uniform(0, 1, (30, 3))
-    pairs = connectivity.candidate_pairs(joints, neighbours=4)
+    pairs = tree_features.candidate_pairs(joints, neighbours=4)
     assert pairs.dtype == np.int64 and pairs.shape[1] == 2
     assert np.all(pairs[:, 0] < pairs[:, 1])
     assert len(np.unique(pairs, axis=0)) == len(pairs)
@@ -217,8 +217,8 @@ def test_candidate_pairs_are_unique_ordered_and_hold_each_nearest_neighbour():
         for other in np.argsort(row)[:4]:
             assert tuple(sorted((joint, int(other)))) in listed
     # Every joint with every other when there are fewer than the neighbours.
-    assert edge_set(connectivity.candidate_pairs(joints[:3])) == {(0, 1), (0, 2), (1, 2)}
-    assert connectivity.candidate_pairs(joints[:1]).shape == (0, 2)
+    assert edge_set(tree_features.candidate_pairs(joints[:3])) == {(0, 1), (0, 2), (1, 2)}
+    assert tree_features.candidate_pairs(joints[:1]).shape == (0, 2)
 
 
 def test_spanning_tree_takes_the_most_probable_pairs():
@@ -247,7 +247,7 @@ def mirrored_edges_missing(edges, mirror):
 
 
 def test_spanning_tree_is_symmetric_on_a_symmetric_figure():
-    pairs = connectivity.candidate_pairs(FIGURE)
+    pairs = tree_features.candidate_pairs(FIGURE)
     # Every true bone likely, everything else not, each with its own noise
     # (twin pairs do not get equal scores): the tree is the figure's, mirrored.
     rng = np.random.default_rng(7)
@@ -262,7 +262,7 @@ def test_spanning_tree_is_symmetric_on_a_symmetric_figure():
 def test_spanning_tree_is_symmetric_when_twins_are_the_nearest_pairs():
     # Probabilities falling with length alone: the knees (0.2 apart) and the
     # feet (0.2) are each other's nearest joints, as on a narrow stance.
-    pairs = connectivity.candidate_pairs(FIGURE)
+    pairs = tree_features.candidate_pairs(FIGURE)
     lengths = np.linalg.norm(FIGURE[pairs[:, 0]] - FIGURE[pairs[:, 1]], axis=1)
     edges = connectivity.spanning_tree(len(FIGURE), pairs, np.exp(-lengths), FIGURE_MIRROR, FIGURE)
     assert is_tree(len(FIGURE), edges)
@@ -289,18 +289,18 @@ def symmetric_solid():
 
 
 def test_pair_features_do_not_change_when_the_pair_is_swapped(symmetric_solid):
-    pairs = connectivity.candidate_pairs(FIGURE)
-    features = connectivity.pair_features(FIGURE, pairs, symmetric_solid, FIGURE_MIRROR)
-    assert features.shape == (len(pairs), connectivity.PAIR_FEATURES) and features.dtype == np.float32
-    swapped = connectivity.pair_features(FIGURE, pairs[:, ::-1], symmetric_solid, FIGURE_MIRROR)
+    pairs = tree_features.candidate_pairs(FIGURE)
+    features = tree_features.pair_features(FIGURE, pairs, symmetric_solid, FIGURE_MIRROR)
+    assert features.shape == (len(pairs), tree_features.PAIR_FEATURES) and features.dtype == np.float32
+    swapped = tree_features.pair_features(FIGURE, pairs[:, ::-1], symmetric_solid, FIGURE_MIRROR)
     np.testing.assert_allclose(swapped, features, atol=1e-6)
 
 
 def test_pair_features_do_not_change_when_left_and_right_are_mirrored(symmetric_solid):
-    pairs = connectivity.candidate_pairs(FIGURE)
-    features = connectivity.pair_features(FIGURE, pairs, symmetric_solid, FIGURE_MIRROR)
+    pairs = tree_features.candidate_pairs(FIGURE)
+    features = tree_features.pair_features(FIGURE, pairs, symmetric_solid, FIGURE_MIRROR)
     # The figure mirrored in place (joint k at its mirror image).
-    mirrored = connectivity.pair_features(FIGURE * [-1, 1, 1], pairs, symmetric_solid, FIGURE_MIRROR)
+    mirrored = tree_features.pair_features(FIGURE * [-1, 1, 1], pairs, symmetric_solid, FIGURE_MIRROR)
     np.testing.assert_allclose(mirrored, features, atol=1e-6)
     # Columns worth checking by hand: the twin flag and the midline flag.
     flags = {tuple(pair): features[k, 16:18].tolist() for k, pair in enumerate(pairs.tolist())}
@@ -311,7 +311,7 @@ def test_twin_pairs_have_the_same_pair_features(symmetric_solid):
     # A midline joint between two twins: (0, 1) and (0, 2) are twin pairs.
     joints = np.array([[0.0, 0.0, 0.5], [0.1, 0.0, 0.5], [-0.1, 0.0, 0.5]])
     mirror = np.array([-1, 2, 1])
-    features = connectivity.pair_features(joints, np.array([[0, 1], [0, 2]]), symmetric_solid, mirror)
+    features = tree_features.pair_features(joints, np.array([[0, 1], [0, 2]]), symmetric_solid, mirror)
     # Each twin is the midline joint's nearest (rank 0) and has it as its nearest.
     np.testing.assert_array_equal(features[:, 12:14], [[0.0, 0.0], [0.0, 0.0]])
     np.testing.assert_array_equal(features[0], features[1])

@@ -1,123 +1,25 @@
-"""The three skinning networks: numpy forward passes (inference inside
-Blender, core/skinning/learned/networks.py) against their torch twins
-(training, core/nn/training/skin_networks.py), the prior an untrained score
-head gives back, and the finishing steps of core/skinning/learned/predict.py."""
+"""The skinning networks run inside Blender: the finishing steps of
+core/skinning/learned/predict.py and whole runs of each shipped network
+(the networks' numpy and torch forwards are compared in
+test_network_twins.py)."""
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.nn.graph import mesh_edges
+from autorig_addon.core.nn.spec import forget_shipped_weights
 from autorig_addon.core.skinning.learned import predict
-from autorig_addon.core.skinning.learned.features import PRIOR_FLOOR, skin_graph
-from autorig_addon.core.skinning.learned.networks import SCORE_FUNCTIONS, candidate_weights
+from autorig_addon.core.skinning.learned.features import skin_graph
+from autorig_addon.core.skinning.learned.networks import NETWORK_NAMES, SKIN_NETWORKS
 from autorig_addon.core.types import Mesh, Skeleton
-from geometry_fixtures import box_mesh, cylinder, procedural_sample, random_skin_inputs, subdivided, two_bone_skeleton
+from geometry_fixtures import box_mesh, cylinder, procedural_sample, subdivided, two_bone_skeleton
 
-import torch
-
-from autorig_addon.core.nn.training.export import module_weights  # noqa: E402
-from autorig_addon.core.nn.training.skin_networks import NETWORKS, graph_tensors  # noqa: E402
-
-#: The last layers of each network's score head (zeroed, they score 0).
-SCORE_HEADS = {"rignet": "scores.", "heterskinnet": "scores.", "skinningnet": "join."}
 #: Voxel resolution of the tests' distances (the default 88 is slower and
 #: changes nothing these tests check).
 RESOLUTION = 32
-#: How far numpy and torch may differ on a candidate weight.
-TWIN_TOLERANCE = 1e-5
-
-
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """These graphs are small: two threads on a busy 2-core machine are
-    tens of times slower than one."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
-@pytest.fixture(scope="module")
-def procedural_graphs():
-    """Network inputs of a normalised procedural character, by distance kind."""
-    sample = procedural_sample(5)
-    return {distance: predict.network_graph(sample.mesh, sample.skeleton, distance, resolution=RESOLUTION)
-            for distance in ("geodesic", "hollow")}
-
-
-def trained_like(name, seed, prior_scale=0.8):
-    """A network with seeded random parameters doubled, so scores reach a
-    few units as after training (the initial ones are about 0.1), in eval mode."""
-    torch.manual_seed(seed)
-    network = NETWORKS[name]().eval()
-    with torch.no_grad():
-        for parameter in network.parameters():
-            parameter.mul_(2.0)
-        network.prior_scale.fill_(prior_scale)
-    return network
-
-
-def prior_weights(graph):
-    """What a network whose scores are all 0 gives with prior_scale 1:
-    softmax of log(prior + floor) over the valid candidates, i.e. the
-    prior plus the floor, renormalised over them."""
-    lifted = np.where(graph.valid, graph.prior.astype(np.float64) + PRIOR_FLOOR, 0.0)
-    return lifted / lifted.sum(axis=1, keepdims=True)
-
-
-def both_forward_passes(name, network, graph):
-    """(numpy, torch) candidate weights of ``network`` on ``graph``."""
-    weights = module_weights(network)
-    result = candidate_weights(SCORE_FUNCTIONS[name](weights, graph), graph, float(weights["prior_scale"]))
-    with torch.no_grad():
-        expected = network(graph_tensors(graph)).numpy()
-    return result, expected
-
-
-@pytest.mark.parametrize("name", sorted(NETWORKS))
-@pytest.mark.parametrize("vertex_count, bone_count", [(12, 1), (40, 3), (150, 9)])
-def test_numpy_and_torch_give_the_same_weights_on_random_graphs(name, vertex_count, bone_count):
-    graph = skin_graph(*random_skin_inputs(vertex_count + bone_count, vertex_count, bone_count))
-    assert graph.mesh_edges[:, graph.mesh_edges[1] == vertex_count - 1].tolist() == [[vertex_count - 1]] * 2
-    result, expected = both_forward_passes(name, trained_like(name, seed=bone_count), graph)
-    assert result.dtype == np.float32 and result.shape == (vertex_count, 5)
-    np.testing.assert_allclose(result, expected, atol=TWIN_TOLERANCE, rtol=0)
-    assert not result[~graph.valid].any()
-    np.testing.assert_allclose(result.sum(axis=1), 1, atol=1e-6)
-    if bone_count > 1:  # the network moves the weights well away from the prior
-        assert np.abs(result - prior_weights(graph)).max() > 0.05
-
-
-@pytest.mark.parametrize("name", sorted(NETWORKS))
-def test_numpy_and_torch_give_the_same_weights_on_a_procedural_character(name, procedural_graphs):
-    graph = procedural_graphs[predict.NETWORK_DISTANCES[name]]
-    result, expected = both_forward_passes(name, trained_like(name, seed=7), graph)
-    np.testing.assert_allclose(result, expected, atol=TWIN_TOLERANCE, rtol=0)
-    np.testing.assert_allclose(result.sum(axis=1), 1, atol=1e-6)
-    assert np.abs(result - prior_weights(graph)).max() > 0.05
-
-
-@pytest.mark.parametrize("name", sorted(NETWORKS))
-def test_a_zero_score_head_gives_back_the_prior(name, procedural_graphs):
-    network = trained_like(name, seed=3, prior_scale=1.0)
-    with torch.no_grad():
-        for parameter_name, parameter in network.named_parameters():
-            if parameter_name.startswith(SCORE_HEADS[name]):
-                parameter.zero_()
-    graph = procedural_graphs[predict.NETWORK_DISTANCES[name]]
-    result, expected = both_forward_passes(name, network, graph)
-    np.testing.assert_allclose(result, prior_weights(graph), atol=1e-6)
-    np.testing.assert_allclose(expected, prior_weights(graph), atol=1e-6)
-    # By hand on the chain of test_skin_features: a prior (0.8, 0.2) becomes
-    # (0.801, 0.201) / 1.002; a bone the prior leaves at 0 keeps 0.001 / 1.002.
-    chain = skin_graph(Mesh([[1.0, 0, 0.5], [1, 1, 0.5], [1, 0, 1.5]], [[0, 1, 2]]), two_bone_skeleton(2.0),
-                       np.array([[1.0, 1.5], [1.0, 1.5], [1.0, 1.5]]), np.array([[0.8, 0.2], [1.0, 0.0], [0.5, 0.5]]))
-    result, expected = both_forward_passes(name, network, chain)
-    by_hand = [[0.801 / 1.002, 0.201 / 1.002, 0, 0, 0], [1.001 / 1.002, 0.001 / 1.002, 0, 0, 0],
-               [0.5, 0.5, 0, 0, 0]]
-    np.testing.assert_allclose(result, by_hand, atol=1e-6)
-    np.testing.assert_allclose(expected, by_hand, atol=1e-6)
 
 
 def test_dense_weights_spread_the_candidates_into_bone_columns():
@@ -166,18 +68,16 @@ def test_learned_weights_refuse_bad_input():
 
 
 def test_a_missing_weights_file_is_refused_before_any_work(monkeypatch, tmp_path):
-    monkeypatch.setattr(predict, "TRAINED_FOLDER", tmp_path)
-    predict.trained_network.cache_clear()
-    try:
-        with pytest.raises(InputError, match=r"^The trained weights of 'skinningnet' are missing .*reinstall the extension"):
-            predict.learned_weights(cylinder(radius=0.1, rings=6), two_bone_skeleton(), "skinningnet")
-    finally:
-        predict.trained_network.cache_clear()
+    spec = SKIN_NETWORKS["skinningnet"]
+    monkeypatch.setitem(SKIN_NETWORKS, "skinningnet", replace(spec, weights_file=tmp_path / "skinningnet.npz"))
+    forget_shipped_weights()
+    with pytest.raises(InputError, match=r"^The trained weights of 'skinningnet' are missing .*reinstall the extension"):
+        predict.learned_weights(cylinder(radius=0.1, rings=6), two_bone_skeleton(), "skinningnet")
 
 
 
 
-@pytest.mark.parametrize("name", predict.NETWORK_NAMES)
+@pytest.mark.parametrize("name", NETWORK_NAMES)
 def test_learned_weights_of_a_procedural_character(name):
     sample = procedural_sample(5)
     weights = predict.learned_weights(sample.mesh, sample.skeleton, name, resolution=RESOLUTION)
@@ -186,8 +86,8 @@ def test_learned_weights_of_a_procedural_character(name):
     np.testing.assert_allclose(weights.matrix.sum(axis=1), 1, atol=1e-12)
     assert (weights.matrix >= 0).all() and ((weights.matrix > 0).sum(axis=1) <= 4).all()
     # A two-bone skeleton (fewer bones than candidates) is weighted as well,
-    # except by RigNet's network, which refuses it (MIN_DEFORM_BONES).
-    if predict.MIN_DEFORM_BONES.get(name, 1) > 2:
+    # except by RigNet's network, which refuses it (its spec's min_deform_bones).
+    if SKIN_NETWORKS[name].min_deform_bones > 2:
         with pytest.raises(InputError, match="^rignet needs at least 5 deform bones and the armature has 2"):
             predict.learned_weights(cylinder(radius=0.1, rings=11), two_bone_skeleton(), name, resolution=RESOLUTION)
         return

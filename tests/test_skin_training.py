@@ -1,6 +1,6 @@
 """Training the skinning networks: the examples and their variants
-(core/skinning/learned/training_set.py), the on-the-fly augmentation, the
-loss and a tiny reproducible run (core/nn/training/skin_training.py)."""
+(training/skinning/learned/training_set.py), the on-the-fly augmentation,
+the loss and a tiny reproducible run (training/skinning/learned/train.py)."""
 
 import math
 
@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.nn.graph import mesh_edges
-from autorig_addon.core.skinning.learned import predict, training_set
+from autorig_addon.core.skinning.learned import predict
+from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
 from autorig_addon.core.skinning.learned.features import (
     BONE_FEATURES,
     BONE_VECTORS,
@@ -20,12 +21,15 @@ from autorig_addon.core.skinning.learned.features import (
     skin_graph,
 )
 from autorig_addon.core.types import Mesh, Skeleton
+from autorig_addon.training.skinning.learned import training_set
 from geometry_fixtures import procedural_sample, random_skin_inputs
 
-import torch
+torch = pytest.importorskip("torch")
+pytestmark = pytest.mark.torch
 
-from autorig_addon.core.nn.training.skin_networks import graph_tensors  # noqa: E402
-from autorig_addon.core.nn.training.skin_training import (  # noqa: E402
+from autorig_addon.training.nn.modules import as_tensors  # noqa: E402
+from autorig_addon.training.runs import procedural_samples, start_run  # noqa: E402
+from autorig_addon.training.skinning.learned.train import (  # noqa: E402
     augmented,
     candidate_cross_entropy,
     holdout_scores,
@@ -57,7 +61,7 @@ def vector_columns(starts, width):
 @pytest.mark.parametrize("matrix", [TURN_MATRIX, MIRROR_MATRIX], ids=["turn", "mirror"])
 def test_augmented_turns_the_vector_columns_and_nothing_else(matrix):
     graph = skin_graph(*random_skin_inputs(1, 30, 7))
-    result = augmented(graph_tensors(graph), matrix)
+    result = augmented(as_tensors(graph), matrix)
     for name, starts, width in (("vertex_features", VERTEX_VECTORS, VERTEX_FEATURES),
                                 ("pair_features", PAIR_VECTORS, PAIR_FEATURES),
                                 ("bone_features", BONE_VECTORS, BONE_FEATURES)):
@@ -87,7 +91,7 @@ def test_augmented_features_are_those_of_the_turned_character(matrix):
                       mesh.triangles[:, ::-1] if np.linalg.det(matrix) < 0 else mesh.triangles)
     moved_skeleton = Skeleton(skeleton.joints @ matrix.T, skeleton.parents, skeleton.names, skeleton.tails @ matrix.T)
     moved = skin_graph(moved_mesh, moved_skeleton, distances, prior)
-    result = augmented(graph_tensors(skin_graph(mesh, skeleton, distances, prior)), matrix)
+    result = augmented(as_tensors(skin_graph(mesh, skeleton, distances, prior)), matrix)
     for name in ("vertex_features", "pair_features", "bone_features"):
         np.testing.assert_allclose(getattr(result, name).numpy(), getattr(moved, name), atol=1e-5, err_msg=name)
 
@@ -115,11 +119,12 @@ def tiny_training_set():
 
 def test_a_training_run_is_reproducible_and_keeps_its_best_epoch(tiny_training_set):
     train, holdout = tiny_training_set
+    spec = SKIN_NETWORKS["skinningnet"]
     runs = []
     for _ in range(2):
         lines = []
-        weights, record = train_network("skinningnet", train, holdout, epochs=2, seed=3, width=16, log=lines.append)
-        runs.append(weights)
+        record = start_run(spec, seed=3, device="cpu", epochs=2, learning_rate=None, score_name="l1")
+        runs.append(train_network(spec, train, holdout, record, log=lines.append))
     first, second = runs
     assert sorted(first) == sorted(second)
     for name in first:
@@ -127,14 +132,16 @@ def test_a_training_run_is_reproducible_and_keeps_its_best_epoch(tiny_training_s
     assert [entry["epoch"] for entry in record.history] == [0, 1, 2]
     assert record.history[0]["loss"] is None and all(entry["loss"] > 0 for entry in record.history[1:])
     l1s = [entry["l1"] for entry in record.history]
-    assert record.best_l1 == min(l1s) and record.best_epoch == l1s.index(min(l1s))
+    assert record.best_score == min(l1s) and record.best_epoch == l1s.index(min(l1s))
     # The returned weights are the kept epoch's: the numpy forward pass scores them the same.
-    assert holdout_scores("skinningnet", first, [(graph, reference) for _, graph, reference in holdout])["l1"] == \
-        pytest.approx(record.best_l1, abs=1e-12)
+    assert holdout_scores(spec, first, [(graph, reference) for _, graph, reference in holdout])["l1"] == \
+        pytest.approx(record.best_score, abs=1e-12)
     assert record.parameters == sum(value.size for name, value in first.items())
+    assert record.learning_rate == spec.training.learning_rate and record.details["train_examples"] == 2
     assert len(lines) == 3 and "epoch 2/2" in lines[-1]
     # Another seed trains another network.
-    other, _ = train_network("skinningnet", train, holdout, epochs=1, seed=4, width=16, log=lambda line: None)
+    other = train_network(spec, train, holdout, start_run(spec, seed=4, device="cpu", epochs=1, learning_rate=None,
+                                                          score_name="l1"), log=lambda line: None)
     assert not np.array_equal(other["join.linears.0.weight"], first["join.linears.0.weight"])
 
 
@@ -191,8 +198,6 @@ def test_examples_are_written_once_and_read_back(tmp_path):
 
 
 def test_procedural_samples_are_normalised_characters_named_by_kind_and_seed():
-    from autorig_addon.core.nn.training.skin_run import procedural_samples
-
     samples = procedural_samples(2)
     assert [sample.name.split("_")[-1] for sample in samples] == ["0", "1"]
     for sample in samples:
@@ -202,10 +207,7 @@ def test_procedural_samples_are_normalised_characters_named_by_kind_and_seed():
         np.testing.assert_allclose(sample.weights.sum(axis=1), 1.0, atol=1e-9)
 
 
-def test_every_network_has_its_shipped_training_settings_and_a_known_prior():
-    assert set(training_set.TRAINING_SETTINGS) == set(predict.NETWORK_NAMES)
-    assert set(predict.NETWORK_PRIORS) == set(predict.NETWORK_NAMES)
-    assert set(predict.NETWORK_PRIORS.values()) <= set(predict.PRIOR_KINDS)
+def test_an_unknown_prior_is_refused():
     mesh, skeleton = procedural_sample(5).mesh, procedural_sample(5).skeleton
     with pytest.raises(ValueError, match=r"^Unknown prior 'magic'"):
         predict.network_graph(mesh, skeleton, "hollow", prior="magic", resolution=32)

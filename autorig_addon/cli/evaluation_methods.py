@@ -30,7 +30,7 @@ from typing import Callable
 
 from ..core.dataset.split import DataItem
 from ..core.errors import InputError
-from ..core.skinning.learned.predict import NETWORK_NAMES
+from ..core.skinning.learned.networks import NETWORK_NAMES
 from ..core.skinning.methods import SKIN_METHOD_DESCRIPTIONS
 
 #: Skin method that returns the reference itself: a sanity check of the

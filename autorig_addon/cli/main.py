@@ -14,13 +14,15 @@ error (:class:`~.exit_codes.UsageError` or a bad argument). See
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
 import os
 import sys
 from dataclasses import dataclass
 from typing import Callable
 
 from ..core.errors import InputError
-from . import evaluate, package, rig, skin, train, transfer
+from . import evaluate, package, rig, skin, transfer
 from .exit_codes import EXIT_FAILED, EXIT_USAGE, UsageError
 
 
@@ -42,7 +44,14 @@ def register_subcommand(name: str, help: str, add_arguments, run) -> None:
     SUBCOMMANDS[name] = Subcommand(help, add_arguments, run)
 
 
-for _module in (transfer, skin, rig, evaluate, package, train):
+#: The ``train`` subcommand's package and module, relative to this one: the
+#: training package, which a source checkout has and the extension zip leaves out.
+TRAINING_PACKAGE, TRAINING_COMMAND = "..training", "..training.command"
+
+_modules = [transfer, skin, rig, evaluate, package]
+if importlib.util.find_spec(TRAINING_PACKAGE, __package__) is not None:
+    _modules.append(importlib.import_module(TRAINING_COMMAND, __package__))
+for _module in _modules:
     register_subcommand(_module.NAME, _module.HELP, _module.add_arguments, _module.run)
 
 

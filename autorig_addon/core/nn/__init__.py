@@ -1,27 +1,18 @@
-"""Graph networks: the kernels, layers and weight files the learned
-skinning networks share.
+"""Graph networks in numpy: the foundation every learned part of the add-on
+runs on inside Blender, below ``skinning/`` and ``rigging/``.
 
-Two twins of every kernel exist:
+* :mod:`.spec`: what defines a network once (its :class:`~.spec.NetworkSpec`:
+  names, parameter layout, forward, training settings, shipped weights);
+* :mod:`.operations`: the table of kernels a forward is written against,
+  and :mod:`.numpy_kernels`, the numpy one (the torch one is in the
+  training package, ``autorig_addon/training/nn/torch_kernels.py``);
+* :mod:`.layers`, :mod:`.aggregation`, :mod:`.convolution`: the layers
+  built of those kernels, written once for both (MLP, segment reductions
+  by name, EdgeConv, GMEdgeConv, SkinningNet's multi-aggregator convolution);
+* :mod:`.graph`: edge indices (mesh one-ring, geodesic balls, vertex to
+  nearest bones, bone hierarchy);
+* :mod:`.weights_io`: weight files (flat ``state_dict``-named arrays in ``.npz``).
 
-* the numpy modules here (:mod:`.graph`, :mod:`.aggregation`,
-  :mod:`.layers`, :mod:`.weights_io`) run the networks inside Blender, where
-  torch is absent;
-* the torch modules under :mod:`.training` train them, with the same
-  function names and signatures, so a forward pass reads the same in both.
-
-The rule that keeps torch out of Blender: **only modules inside the
-``training`` sub-package may import torch, and nothing outside it imports
-from it**. ``tests/test_core_without_blender.py`` imports every other module
-in a fresh interpreter and scans their source, and fails when torch or the
-training package is reached; the extension zip leaves the training package
-out (``autorig_addon/packaging.py``).
-
-A network's weights are one flat ``{name: array}`` dict whose names are the
-torch ``state_dict`` keys (``"conv1.mlp.linears.0.weight"``), so the numpy
-forward pass reads the same names the torch module wrote.
+Nothing here imports torch; the training package imports from here, never
+the reverse (``tests/test_core_without_blender.py`` checks).
 """
-
-#: The sub-package holding every torch-importing module (dotted name
-#: relative to ``autorig_addon``); the import guard tests and the extension
-#: packaging both recognise torch-only code by it.
-TRAINING_PACKAGE = "core.nn.training"

@@ -1,7 +1,7 @@
 """Network weight files: a flat ``{name: array}`` dict in a compressed ``.npz``.
 
 The names are the torch ``state_dict`` keys of the trained module
-(:func:`autorig_addon.core.nn.training.export.module_weights` writes them),
+(``autorig_addon.training.nn.modules.module_weights`` writes them),
 so the numpy forward pass reads the names the torch module wrote. Two
 reserved entries travel with the arrays: the file format version
 (:data:`WEIGHTS_FORMAT_VERSION`) and a JSON metadata dict (the network's

@@ -2,135 +2,48 @@
 
 RigNet's BoneNet scores every joint pair from the joints and a shape code,
 its RootNet picks the root, and a minimum spanning tree over ``-log``
-bone probabilities gives the hierarchy. Ours keeps that plan with features
-that generalise from a few dozen characters: a pair is described by its
-offsets, its place on the body and, above all, by how the solid looks
-along the segment between the two joints (a bone runs inside the body; a
-pair from one leg to the other crosses air), measured on the same voxel
-depth as the joint network's input (:class:`.joint_features.SolidDepth`).
-Every feature is unchanged by swapping the pair or mirroring left and
-right, so the scores of twin pairs agree.
+bone probabilities gives the hierarchy. Ours keeps that plan with the
+features of :mod:`.tree_features`:
 
-* :func:`bone_probabilities`: a small MLP over :func:`pair_features` of
-  each joint's :data:`CANDIDATE_NEIGHBOURS` nearest joints;
-* :func:`root_scores`: a small MLP over :func:`root_features`, softmaxed
-  over joints (on a symmetric character only midline joints may be root);
+* :func:`bone_probabilities`: the bone network (:mod:`.networks.bones`)
+  over the pair features of each joint's nearest joints;
+* :func:`root_scores`: the root network (:mod:`.networks.root`) over the
+  joints' root features, softmaxed over joints (on a symmetric character
+  only midline joints may be root);
 * :func:`spanning_tree`: Kruskal's tree over ``-log p``, taking each edge's
   mirror twin right after it so that left and right get the same bones;
   pairs the network did not score join only parts left apart, shortest first.
-
-Torch twins: :mod:`autorig_addon.core.nn.training.rig_networks`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from ..nn.layers import mlp, sigmoid
-from .joint_features import SolidDepth
-from .joint_network import ACTIVATION
+from ..nn.numpy_kernels import NUMPY, sigmoid
+from ..nn.spec import shipped_weights
+from .networks import bones, root
 
-#: Each joint's nearest joints whose pairs the bone network scores.
-CANDIDATE_NEIGHBOURS = 8
-#: Points sampled inside each candidate segment to read the solid's depth.
-SEGMENT_SAMPLES = 9
-#: A joint this close to the mirror plane is on the midline (share of the
-#: largest side).
-MIDLINE_TOLERANCE = 0.01
 #: Cost added to pairs the network did not score, so they only join parts
 #: the scored pairs leave apart.
 UNSCORED_PAIR_COST = 1e3
 #: Floor of bone probabilities inside ``-log``.
 PROBABILITY_FLOOR = 1e-6
-#: Pair feature columns (see :func:`pair_features`) and root feature columns.
-PAIR_FEATURES = 19
-ROOT_FEATURES = 9
-#: Least spread a feature is divided by when standardised.
-STD_FLOOR = 1e-4
-#: Radius within which :func:`root_features` counts a joint's neighbours
-#: (share of the largest side).
-ROOT_NEIGHBOURHOOD = 0.1
 
 
-def candidate_pairs(joints: np.ndarray, neighbours: int = CANDIDATE_NEIGHBOURS) -> np.ndarray:
-    """(p, 2) int64 pairs ``i < j``, each joint with its nearest joints."""
-    count = len(joints)
-    if count < 2:
-        return np.zeros((0, 2), dtype=np.int64)
-    k = min(neighbours, count - 1)
-    _, nearest = cKDTree(joints).query(joints, k=k + 1)
-    rows = np.repeat(np.arange(count), k)
-    others = nearest[:, 1:].reshape(-1)
-    pairs = np.sort(np.stack([rows, others], axis=1), axis=1)
-    return np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0)
+def bone_probabilities(features: np.ndarray, weights: dict | None = None) -> np.ndarray:
+    """(p,) probability that each scored pair is a bone, from its
+    :func:`.tree_features.pair_features`: the bone network with its shipped
+    weights, or ``weights`` (a training run's)."""
+    params = shipped_weights(bones.SPEC).weights if weights is None else weights
+    return sigmoid(bones.SPEC.forward(NUMPY, params, features))
 
 
-def pair_features(joints: np.ndarray, pairs: np.ndarray, solid: SolidDepth, mirror: np.ndarray) -> np.ndarray:
-    """(p, PAIR_FEATURES) float32 description of each pair ``(i, j)``.
-
-    Columns: length; |dx|, |dy|, |dz|; mean |x|, y, z; share of the segment
-    inside the solid; least and mean depth along it; least and greatest
-    depth of the two joints; least and greatest neighbour rank of each end
-    in the other's list; log of the length over each end's nearest-joint
-    distance (least, greatest); whether the pair are mirror twins; whether
-    both lie on the midline; the least depth along the segment over the
-    lesser joint depth (a neck narrowing between them).
-    """
-    i, j = pairs[:, 0], pairs[:, 1]
-    a, b = joints[i], joints[j]
-    delta = np.abs(b - a)
-    length = np.linalg.norm(b - a, axis=1)
-    t = np.linspace(0.0, 1.0, SEGMENT_SAMPLES + 2)[1:-1]
-    along = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]
-    depth_along = solid.at(along.reshape(-1, 3)).reshape(len(pairs), SEGMENT_SAMPLES)
-    joint_depth = solid.at(joints)
-    end_depth = np.stack([joint_depth[i], joint_depth[j]], axis=1)
-    rank = _neighbour_ranks(joints, pairs)
-    nearest = _nearest_joint_distance(joints)
-    ratio = np.log(np.maximum(length[:, None], 1e-9) / np.maximum(np.stack([nearest[i], nearest[j]], axis=1), 1e-9))
-    midline = np.abs(joints[:, 0]) <= MIDLINE_TOLERANCE
-    least_end = end_depth.min(axis=1)
-    columns = [
-        length, delta[:, 0], delta[:, 1], delta[:, 2],
-        (np.abs(a[:, 0]) + np.abs(b[:, 0])) / 2, (a[:, 1] + b[:, 1]) / 2, (a[:, 2] + b[:, 2]) / 2,
-        (depth_along > 0).mean(axis=1), depth_along.min(axis=1), depth_along.mean(axis=1),
-        least_end, end_depth.max(axis=1),
-        rank.min(axis=1), rank.max(axis=1), ratio.min(axis=1), ratio.max(axis=1),
-        (np.asarray(mirror)[i] == j).astype(np.float64), (midline[i] & midline[j]).astype(np.float64),
-        np.divide(depth_along.min(axis=1), least_end, out=np.zeros(len(pairs)), where=least_end > 0),
-    ]
-    return np.stack(columns, axis=1).astype(np.float32)
-
-
-def root_features(joints: np.ndarray, solid: SolidDepth) -> np.ndarray:
-    """(j, ROOT_FEATURES) float32: |x|, y, z, depth, distance to the joints'
-    centroid, height and depth over the joints' means, share of joints
-    within :data:`ROOT_NEIGHBOURHOOD`, depth rank (0 the deepest)."""
-    depth = solid.at(joints)
-    centroid = joints.mean(axis=0)
-    near = cKDTree(joints).query_ball_point(joints, ROOT_NEIGHBOURHOOD, return_length=True) / max(len(joints), 1)
-    depth_rank = np.argsort(np.argsort(-depth)) / max(len(joints) - 1, 1)
-    columns = [np.abs(joints[:, 0]), joints[:, 1], joints[:, 2], depth, np.linalg.norm(joints - centroid, axis=1),
-               joints[:, 2] - centroid[2], depth - depth.mean(), near, depth_rank]
-    return np.stack(columns, axis=1).astype(np.float32)
-
-
-def standardised_mlp(weights: dict, features: np.ndarray) -> np.ndarray:
-    """(r,) output of the bone or root network: an MLP on the features
-    standardised by the training data's ``input_mean`` and ``input_std``."""
-    standard = (features - weights["input_mean"]) / weights["input_std"]
-    return mlp(standard, weights, "mlp.", activation=ACTIVATION, activate_last=False)[:, 0]
-
-
-def bone_probabilities(weights: dict, features: np.ndarray) -> np.ndarray:
-    """(p,) probability that each scored pair is a bone."""
-    return sigmoid(standardised_mlp(weights, features))
-
-
-def root_scores(weights: dict, features: np.ndarray) -> np.ndarray:
-    """(j,) root score of each joint (higher: more likely the root)."""
-    return standardised_mlp(weights, features)
+def root_scores(features: np.ndarray, weights: dict | None = None) -> np.ndarray:
+    """(j,) root score of each joint (higher: more likely the root), from its
+    :func:`.tree_features.root_features`: the root network with its shipped
+    weights, or ``weights``."""
+    params = shipped_weights(root.SPEC).weights if weights is None else weights
+    return root.SPEC.forward(NUMPY, params, features)
 
 
 def spanning_tree(joint_count: int, pairs: np.ndarray, probabilities: np.ndarray, mirror: np.ndarray,
@@ -210,23 +123,3 @@ def oriented_tree(joint_count: int, edges: np.ndarray, root: int) -> tuple[np.nd
     new_index = {old: new for new, old in enumerate(order)}
     parents = np.array([new_index[parent_of[old]] if parent_of[old] >= 0 else -1 for old in order], dtype=np.int64)
     return np.array(order, dtype=np.int64), parents
-
-
-def _neighbour_ranks(joints: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """(p, 2) rank of ``j`` among ``i``'s nearest joints and of ``i`` among
-    ``j``'s, 0 the nearest, as a share of :data:`CANDIDATE_NEIGHBOURS`."""
-    distances = np.linalg.norm(joints[:, None, :] - joints[None, :, :], axis=2)
-    np.fill_diagonal(distances, np.inf)
-    # The count of strictly nearer joints: ties (a joint's two twins) share
-    # a rank, so mirrored pairs get the same features.
-    i, j = pairs[:, 0], pairs[:, 1]
-    rank = np.zeros(distances.shape, dtype=np.int64)
-    rank[i, j] = (distances[i] < distances[i, j][:, None]).sum(axis=1)
-    rank[j, i] = (distances[j] < distances[j, i][:, None]).sum(axis=1)
-    return np.stack([rank[i, j], rank[j, i]], axis=1) / CANDIDATE_NEIGHBOURS
-
-
-def _nearest_joint_distance(joints: np.ndarray) -> np.ndarray:
-    if len(joints) < 2:
-        return np.zeros(len(joints))
-    return cKDTree(joints).query(joints, k=2)[0][:, 1]

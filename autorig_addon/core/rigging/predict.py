@@ -4,7 +4,7 @@
    triangles are simplified to a proxy of :data:`.joint_features.PROXY_VERTICES`
    vertices, moved into RigNet's normalised frame (feet at z = 0, largest
    side 1), checked for orientation, and the joint network moves every
-   vertex toward its joint and weighs its vote (:mod:`.joint_network`).
+   vertex toward its joint and weighs its vote (:mod:`.networks.joints`).
 2. :func:`skeleton_from_votes` (fast, so the level-of-detail slider answers
    at once): attention-weighted mean shift of the votes at the chosen
    *bandwidth* (:mod:`.mean_shift`), mirrored across the character's plane
@@ -21,8 +21,6 @@ turned for the network; one lying on its side is refused with a message.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
@@ -30,18 +28,18 @@ from ..dataset.normalise import apply_transform, normalisation_transform
 from ..errors import InputError
 from ..geometry.outliers import without_vertices
 from ..geometry.proxy import simplified_proxy
-from ..nn.weights_io import load_weights
+from ..nn.numpy_kernels import NUMPY, sigmoid
+from ..nn.spec import shipped_weights
 from ..progress import ProgressCallback, report
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
-from .connectivity import (
-    bone_probabilities, candidate_pairs, oriented_tree, pair_features, root_features, root_scores, spanning_tree,
-)
+from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
-from .joint_network import joint_outputs
+from .networks import joints as joint_network
 from .mean_shift import mean_shift_modes
 from .role_names import role_names
 from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
+from .tree_features import candidate_pairs, pair_features, root_features
 
 #: Mean-shift bandwidth, share of the character's largest side: the level
 #: of detail (smaller: more joints). On the held-out training characters
@@ -73,11 +71,6 @@ LONE_BONE_LENGTH = 0.02
 LEAF_INSIDE_SHARE = 0.8
 #: Points sampled along a leaf bone to find where it leaves the solid.
 LEAF_SAMPLES = 16
-#: The shipped weights of the three networks.
-TRAINED_FOLDER = Path(__file__).resolve().parent / "trained"
-NETWORK_FILES = {"joints": "joints.npz", "bones": "bones.npz", "root": "root.npz"}
-NETWORK_NAMES = tuple(NETWORK_FILES)
-
 
 @dataclass(frozen=True)
 class JointVotes:
@@ -100,19 +93,6 @@ class JointVotes:
     transform: np.ndarray
     symmetric: bool
     notes: tuple = ()
-
-
-def trained_weights_path(network: str) -> Path:
-    return TRAINED_FOLDER / NETWORK_FILES[network]
-
-
-@lru_cache(maxsize=None)
-def trained_network(network: str) -> dict:
-    """The shipped weights of ``joints``, ``bones`` or ``root``."""
-    path = trained_weights_path(network)
-    if not path.is_file():
-        raise InputError(f"The trained {network} network is missing ({path}); reinstall the extension.")
-    return load_weights(str(path)).weights
 
 
 def facing_turns(vertices: np.ndarray) -> int:
@@ -154,7 +134,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     if len(mesh.triangles) < MIN_FACES:
         raise InputError(f"The mesh has {len(mesh.triangles)} faces; predicting a skeleton needs a character "
                          f"surface of at least {MIN_FACES}.")
-    weights = trained_network("joints")
+    weights = shipped_weights(joint_network.SPEC).weights
     report(progress, 0.0, "Simplifying the mesh")
     # Vertices in no face have no surface to read; the proxy would keep them.
     faceless = np.ones(mesh.vertex_count, dtype=bool)
@@ -188,7 +168,7 @@ def graph_votes(weights: dict, graph: JointGraph, solid: SolidDepth | None = Non
 
     Parameters
     ----------
-    weights : dict, the joint network's weights (:func:`trained_network` or a training run's)
+    weights : dict, the joint network's weights (shipped, or a training run's)
     graph : JointGraph of the normalised proxy (:func:`.joint_features.joint_graph`)
     solid : its SolidDepth, when the votes will be connected into a skeleton
     transform : (4, 4) float64 from the mesh's space to the normalised frame; default identity
@@ -198,7 +178,8 @@ def graph_votes(weights: dict, graph: JointGraph, solid: SolidDepth | None = Non
     JointVotes, symmetric when the graph's vertices are left-right symmetric
     (:data:`.symmetry.SYMMETRY_TOLERANCE`), without notes.
     """
-    offsets, attention = joint_outputs(weights, graph)
+    offsets, logits = joint_network.SPEC.forward(NUMPY, weights, graph)
+    attention = sigmoid(logits)
     symmetric = mirror_error(graph.vertices, 0) <= SYMMETRY_TOLERANCE
     return JointVotes(graph.vertices + offsets, attention, solid, np.eye(4) if transform is None else transform,
                       symmetric)
@@ -223,9 +204,9 @@ def connect_joints(joints: np.ndarray, mirror: np.ndarray, solid: SolidDepth) ->
     count = len(joints)
     pairs = candidate_pairs(joints)
     features = pair_features(joints, pairs, solid, mirror)
-    probabilities = bone_probabilities(trained_network("bones"), features) if len(pairs) else np.zeros(0)
+    probabilities = bone_probabilities(features) if len(pairs) else np.zeros(0)
     edges = spanning_tree(count, pairs, probabilities, mirror, joints)
-    scores = root_scores(trained_network("root"), root_features(joints, solid))
+    scores = root_scores(root_features(joints, solid))
     midline = mirror < 0
     if np.any(mirror >= 0) and midline.any():
         scores = np.where(midline, scores, -np.inf)

@@ -22,7 +22,8 @@ from ..errors import InputError
 from ..progress import ProgressCallback
 from ..types import Mesh, Skeleton, Weights
 from .geometric import DEFAULT_MAX_INFLUENCES, geometric_weights
-from .learned.predict import NETWORK_NAMES, learned_weights
+from .learned.networks import NETWORK_NAMES, SKIN_NETWORKS
+from .learned.predict import learned_weights
 
 #: The method without training: :func:`.geometric.geometric_weights`.
 GEOMETRIC = "geometric"
@@ -33,23 +34,13 @@ SKIN_METHODS = (GEOMETRIC,) + NETWORK_NAMES
 #: mean and median L1 of the three and, seeing HollowDist, also weights
 #: open meshes and bones outside the body.
 DEFAULT_SKIN_METHOD = "heterskinnet"
-#: Short names the panel shows, per method.
-SKIN_METHOD_LABELS = {
-    GEOMETRIC: "Geometric",
-    "rignet": "RigNet",
-    "heterskinnet": "HeterSkinNet",
-    "skinningnet": "SkinningNet",
-}
+#: Short names the panel shows, per method (the networks' from their specs).
+SKIN_METHOD_LABELS = {GEOMETRIC: "Geometric", **{name: spec.label for name, spec in SKIN_NETWORKS.items()}}
 #: One line per method: the panel's tooltips, the command line's help and
-#: ``eval``'s method list.
+#: ``eval``'s method list (the networks' from their specs).
 SKIN_METHOD_DESCRIPTIONS = {
     GEOMETRIC: "Bone heat diffused over the surface from voxel distances through the shape, no training",
-    "rignet": "RigNet's network (Xu et al. 2020) trained on artists' rigs: graph convolutions over the mesh "
-              "and geodesic balls",
-    "heterskinnet": "HeterSkinNet (Pan et al. 2021) trained on artists' rigs: messages between vertices and bones "
-                    "over HollowDist, for bones outside the body and loose parts",
-    "skinningnet": "SkinningNet (Mosella-Montoro and Ruiz-Hidalgo 2022) trained on artists' rigs: mesh and "
-                   "skeleton streams of multi-aggregator graph convolutions",
+    **{name: spec.description for name, spec in SKIN_NETWORKS.items()},
 }
 #: Options of the geometric method alone, by their names here (and in
 #: ``SkinSettings`` and on the command line) -> the keyword of

@@ -10,7 +10,7 @@ training (from cached samples) and inference (inside Blender):
   the shape and the straight one (their ratio says whether something stands
   between them), how much farther the bone is than the vertex's nearest,
   the weight of the prior the network corrects (our geometric method or
-  Blender-style bone heat, :data:`.predict.NETWORK_PRIORS`);
+  Blender-style bone heat: each network spec's ``prior``);
 * **per-vertex features**: position and normal;
 * **per-bone features**: head, tail, direction, length, leaf flag, depth;
 * **graphs**: the mesh one-ring and geodesic balls (RigNet's GMEdgeConv),
@@ -127,7 +127,7 @@ def skin_graph(mesh: Mesh, skeleton: Skeleton, distances: np.ndarray, prior: np.
     skeleton : Skeleton in the same frame; only its deform bones are used
     distances : (n, d) float array, vertex-to-deform-bone distances through
         the shape (volumetric geodesic or HollowDist), same frame
-    prior : (n, d) float array, the prior's weights (:data:`.predict.NETWORK_PRIORS`)
+    prior : (n, d) float array, the prior's weights (a network spec's ``prior``)
 
     Returns
     -------

@@ -11,10 +11,11 @@ Steps, for a mesh and any armature (one an artist edited included):
 2. The character is moved into the normalised frame the networks were
    trained in (:func:`...dataset.normalise.normalise`).
 3. The network's distance through the shape (volumetric geodesic or
-   HollowDist, :data:`NETWORK_DISTANCES`) and the prior's weights
-   from it (the prior, :func:`..geometric.geometric_weights`).
-4. The network's candidate weights (:mod:`.networks`), spread into the
-   (n, d) matrix.
+   HollowDist, its spec's ``distance``) and the weights of the prior it
+   corrects (its spec's ``prior``: :func:`..geometric.geometric_weights`
+   or :func:`..heat_prior.heat_prior_weights`).
+4. The network's candidate weights (:mod:`.networks`, run with numpy),
+   spread into the (n, d) matrix.
 5. Back on the original mesh (interpolated at each vertex's closest point
    on the proxy surface, so no blocky seams), and last: at most
    ``max_influences`` bones per vertex, weights at or below
@@ -24,9 +25,6 @@ Steps, for a mesh and any armature (one an artist edited included):
 
 from __future__ import annotations
 
-import functools
-from pathlib import Path
-
 import numpy as np
 
 from ...dataset.normalise import normalise
@@ -35,36 +33,17 @@ from ...distances.hollow_dist import hollow_distances
 from ...distances.volumetric_geodesic import volumetric_geodesic_distances
 from ...errors import InputError
 from ...geometry.proxy import simplified_proxy
-from ...nn.weights_io import load_weights
+from ...nn.numpy_kernels import NUMPY
+from ...nn.spec import shipped_weights
 from ...progress import ProgressCallback, report, sub_progress
 from ...types import Mesh, Skeleton, Weights
 from ...weights import limit_influences, prune_small
 from ..heat_prior import heat_prior_weights
 from ..geometric import DEFAULT_MAX_INFLUENCES, deform_bones_of, geometric_weights
-from .features import CANDIDATE_BONES, SkinGraph, skin_graph
-from .networks import SCORE_FUNCTIONS, candidate_weights
+from .features import SkinGraph, skin_graph
+from .networks import SKIN_NETWORKS, skin_network
+from .networks.scoring import PRIOR_KINDS, SkinNetworkSpec, candidate_weights
 
-#: The trained networks, by name, and the distance each one sees: RigNet
-#: and SkinningNet the volumetric geodesic distance (RigNet's), HeterSkinNet
-#: HollowDist (its paper's, which also reaches bones outside the body).
-NETWORK_DISTANCES = {"rignet": "geodesic", "heterskinnet": "hollow", "skinningnet": "geodesic"}
-#: Fewest deform bones a network weights correctly. RigNet's network reads
-#: each vertex's candidates side by side, and no training character has
-#: fewer than 5 deform bones, so the empty candidate slots of a smaller
-#: skeleton are inputs it has never seen (a two-bone tube came out with its
-#: top on the wrong bone); the other two score each (vertex, bone) pair on
-#: its own and take any skeleton.
-MIN_DEFORM_BONES = {"rignet": CANDIDATE_BONES}
-#: The prior each network corrects: our geometric method's weights, or bone
-#: heat as Blender computes it (:mod:`..heat_prior`).
-NETWORK_PRIORS = {"rignet": "geometric", "heterskinnet": "heat", "skinningnet": "geometric"}
-#: The priors :func:`network_graph` can build.
-PRIOR_KINDS = ("geometric", "heat")
-#: Names a ``--method`` or the panel accepts for a network.
-NETWORK_NAMES = tuple(NETWORK_DISTANCES)
-#: Folder of the trained weights shipped inside the package, one
-#: ``NAME.npz`` per network (:mod:`...nn.weights_io`).
-TRAINED_FOLDER = Path(__file__).resolve().parent / "trained"
 #: Vertices of the proxy the networks see: the training characters' count
 #: (RigNet's users see 1k to 5k).
 NETWORK_PROXY_VERTICES = 3_000
@@ -78,34 +57,6 @@ NETWORK_PROXY_VERTICES = 3_000
 PRUNE_BELOW = 0.03
 
 
-def trained_weights_path(network: str) -> Path:
-    """The shipped weights file of ``network``."""
-    return TRAINED_FOLDER / f"{network}.npz"
-
-
-def network_distance(network: str) -> str:
-    """The distance ``network`` sees; InputError for an unknown name."""
-    if network not in NETWORK_DISTANCES:
-        raise InputError(f"Unknown skinning network '{network}': use one of {', '.join(NETWORK_NAMES)}.")
-    return NETWORK_DISTANCES[network]
-
-
-@functools.lru_cache(maxsize=len(NETWORK_NAMES))
-def trained_network(network: str) -> tuple[dict, dict]:
-    """``(weights, metadata)`` of a shipped network, read once per process.
-
-    Raises
-    ------
-    InputError for an unknown name or a missing file (a broken install).
-    """
-    network_distance(network)
-    path = trained_weights_path(network)
-    if not path.is_file():
-        raise InputError(f"The trained weights of '{network}' are missing ({path}); reinstall the extension.")
-    loaded = load_weights(str(path))
-    return loaded.weights, loaded.metadata
-
-
 def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str = "geometric",
                   resolution: int = DEFAULT_RESOLUTION, progress: ProgressCallback | None = None) -> SkinGraph:
     """The inputs of a network for a character already in the normalised
@@ -115,7 +66,7 @@ def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str =
     ----------
     mesh, skeleton : normalised (:func:`...dataset.normalise.normalise`)
     distance : "geodesic" or "hollow"
-    prior : "geometric" or "heat" (a value of :data:`NETWORK_PRIORS`)
+    prior : one of :data:`.networks.scoring.PRIOR_KINDS`, a network's ``prior``
     resolution : int, voxel cells along the longest side
     progress : optional ProgressCallback
     """
@@ -134,10 +85,11 @@ def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str =
     return skin_graph(mesh, skeleton, distances, prior_weights)
 
 
-def network_candidate_weights(network: str, graph: SkinGraph) -> np.ndarray:
-    """(n, K) candidate weights of a shipped network on ``graph``."""
-    weights, _ = trained_network(network)
-    return candidate_weights(SCORE_FUNCTIONS[network](weights, graph), graph, float(weights["prior_scale"]))
+def network_candidate_weights(spec: SkinNetworkSpec, graph: SkinGraph, weights: dict | None = None) -> np.ndarray:
+    """(n, K) candidate weights of a network on ``graph`` with numpy: its
+    shipped weights, or ``weights`` (a training run's)."""
+    params = shipped_weights(spec).weights if weights is None else weights
+    return candidate_weights(NUMPY, params, graph, spec.forward(NUMPY, params, graph))
 
 
 def dense_weights(graph: SkinGraph, candidate: np.ndarray) -> np.ndarray:
@@ -164,7 +116,7 @@ def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influen
     ----------
     mesh : Mesh, any space (the armature's and the mesh's must agree)
     skeleton : Skeleton; only bones with ``deform`` set get weights
-    network : one of :data:`NETWORK_NAMES`
+    network : one of :data:`.networks.NETWORK_NAMES`
     max_influences : int >= 0, bones kept per vertex (0: no limit)
     resolution : int, voxel cells along the longest side
     progress : optional ProgressCallback
@@ -178,22 +130,22 @@ def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influen
     ------
     InputError for an unknown network, no deform bones or no vertices.
     """
-    distance = network_distance(network)
+    spec = skin_network(network)
     deform = deform_bones_of(mesh, skeleton)
-    fewest = MIN_DEFORM_BONES.get(network, 1)
-    if len(deform) < fewest:
+    if len(deform) < spec.min_deform_bones:
+        takers = [name for name, other in SKIN_NETWORKS.items() if other.min_deform_bones <= len(deform)]
         raise InputError(
-            f"{network} needs at least {fewest} deform bones and the armature has {len(deform)}: "
-            "use heterskinnet, skinningnet or geometric for so small a skeleton.")
-    trained_network(network)  # a missing file fails before the long work
+            f"{network} needs at least {spec.min_deform_bones} deform bones and the armature has {len(deform)}: "
+            f"use {', '.join(takers)} or geometric for so small a skeleton.")
+    shipped_weights(spec)  # a missing file fails before the long work
     report(progress, 0.0, "Welding and simplifying the mesh")
     proxy = simplified_proxy(mesh, NETWORK_PROXY_VERTICES)
     normalised = normalise(proxy.mesh, skeleton)
-    graph = network_graph(normalised.mesh, normalised.skeleton, distance, prior=NETWORK_PRIORS[network],
+    graph = network_graph(normalised.mesh, normalised.skeleton, spec.distance, prior=spec.prior,
                           resolution=resolution,
                           progress=sub_progress(progress, 0.05, 0.9))
     report(progress, 0.9, f"Running {network}")
-    weights = dense_weights(graph, network_candidate_weights(network, graph))
+    weights = dense_weights(graph, network_candidate_weights(spec, graph))
     report(progress, 0.95, "Carrying the weights to every vertex")
     weights = proxy.carry(weights, lambda rows, carried: finished_weights(carried, max_influences))
     report(progress, 1.0, "Weights done")

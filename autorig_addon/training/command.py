@@ -1,5 +1,8 @@
 """``python -m autorig_addon train``: train the skinning and skeleton networks.
 
+Registered by :mod:`autorig_addon.cli.main` when this package is present
+(a source checkout; the extension zip leaves it out).
+
 ``train samples`` builds the cached samples of the characters (needs the
 ``bpy`` module); ``train skin --model NAME`` and ``train rig --model NAME``
 train one network from those samples alone (torch, no Blender: it also
@@ -17,17 +20,17 @@ import sys
 from pathlib import Path
 
 from ..core.dataset.cache import default_cache_dir
-from ..core.rigging import training_set as rig_training_set
-from ..core.rigging.predict import NETWORK_NAMES as RIG_NETWORK_NAMES
-from ..core.skinning.learned.predict import NETWORK_NAMES
-from ..core.skinning.learned.training_set import TRAINING_SETTINGS
-from .exit_codes import EXIT_OK
+from ..core.rigging.networks import NETWORK_NAMES as RIG_NETWORK_NAMES
+from ..core.rigging.networks import RIG_NETWORKS
+from ..core.skinning.learned.networks import NETWORK_NAMES, SKIN_NETWORKS
 
 NAME = "train"
 HELP = "Train the skinning and skeleton networks from cached samples of the training characters"
 
 #: Where the characters of ``data_split.json`` lie, relative to the repository.
 DEFAULT_CHARACTERS = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "characters"
+#: ``--device`` choices (``auto``: the GPU when torch sees one; :func:`.runs.pick_device`).
+DEVICES = ("auto", "cpu", "cuda")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -37,14 +40,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model", choices=NETWORK_NAMES + RIG_NETWORK_NAMES,
                         help=f"The network to train: train skin {'|'.join(NETWORK_NAMES)}; "
                              f"train rig {'|'.join(RIG_NETWORK_NAMES)}")
-    shipped = ", ".join(f"{name} {epochs} epochs at {rate:g}" for name, (epochs, rate)
-                        in {**TRAINING_SETTINGS, **rig_training_set.TRAINING_SETTINGS}.items())
+    shipped = ", ".join(f"{name} {spec.training.epochs} epochs at {spec.training.learning_rate:g}"
+                        for name, spec in {**SKIN_NETWORKS, **RIG_NETWORKS}.items())
     parser.add_argument("--epochs", type=int, default=None,
                         help=f"Epochs (default: the shipped weights' run: {shipped})")
     parser.add_argument("--learning-rate", type=float, default=None,
                         help="Adam's starting learning rate (default: the shipped weights' run, see --epochs)")
     parser.add_argument("--seed", type=int, default=0, help="Random seed (default 0)")
-    parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
+    parser.add_argument("--device", choices=DEVICES, default="auto",
                         help="auto: the GPU when torch sees one (default auto)")
     parser.add_argument("--samples", type=Path, default=None,
                         help="Folder of cached samples (default: the cache, ~/.cache/autorig_addon/samples)")
@@ -62,42 +65,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .exit_codes import UsageError
+    # The command line imports this module while it starts, so its own
+    # modules are imported when the command runs.
+    from ..cli.exit_codes import EXIT_OK, UsageError
 
     samples = args.samples or default_cache_dir()
     if args.what == "samples":
-        return _build_samples(args.characters, samples)
-    if args.what == "rig":
-        return _train_rig(args, samples)
-    if args.model not in NETWORK_NAMES:
-        raise UsageError("train skin needs --model " + "|".join(NETWORK_NAMES) + ".")
-    from ..core.nn.training.skin_run import run_training
+        _build_samples(args.characters, samples)
+        return EXIT_OK
+    names = NETWORK_NAMES if args.what == "skin" else RIG_NETWORK_NAMES
+    if args.model not in names:
+        raise UsageError(f"train {args.what} needs --model " + "|".join(names) + ".")
+    if args.what == "skin":
+        from .skinning.learned.train import run_training
 
-    record = run_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
-                          seed=args.seed, device=args.device, output=args.output, augment=not args.no_augment,
-                          learning_rate=args.learning_rate, procedural=args.procedural)
-    print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out L1 "
-          f"{record['best_l1']:.4f}, {record['seconds']:.0f} s on {record['device']}", file=sys.stderr)
+        record = run_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
+                              seed=args.seed, device=args.device, output=args.output, augment=not args.no_augment,
+                              learning_rate=args.learning_rate, procedural=args.procedural)
+    else:
+        from .rigging.train import run_rig_training
+
+        record = run_rig_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
+                                  learning_rate=args.learning_rate, seed=args.seed, device=args.device,
+                                  output=args.output, procedural=args.procedural)
+    print(f"{record.network}: kept epoch {record.best_epoch} of {record.epochs}, held-out {record.score_name} "
+          f"{record.best_score:.4f}, {record.seconds:.0f} s on {record.device}", file=sys.stderr)
     return EXIT_OK
 
 
-def _train_rig(args: argparse.Namespace, samples: Path) -> int:
-    from .exit_codes import UsageError
-
-    if args.model not in RIG_NETWORK_NAMES:
-        raise UsageError("train rig needs --model " + "|".join(RIG_NETWORK_NAMES) + ".")
-    from ..core.nn.training.rig_run import run_rig_training
-
-    record = run_rig_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
-                              learning_rate=args.learning_rate, seed=args.seed, device=args.device,
-                              output=args.output, procedural=args.procedural)
-    print(f"{args.model}: kept epoch {record['best_epoch']} of {record['epochs']}, held-out "
-          f"{'CD-J2J' if args.model == 'joints' else 'loss'} {record['best_score']:.4f}, {record['seconds']:.0f} s "
-          f"on {record['device']}", file=sys.stderr)
-    return EXIT_OK
-
-
-def _build_samples(characters: Path, samples: Path) -> int:
+def _build_samples(characters: Path, samples: Path) -> None:
     from ..blender.characters import build_character_samples
     from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
     from ..core.errors import InputError
@@ -108,4 +104,3 @@ def _build_samples(characters: Path, samples: Path) -> int:
     paths = [characters / path for path in split.subset("all")]
     built = build_character_samples(paths, cache_dir=samples, root=characters, split=split)
     print(f"{len(built)} samples in {os.fspath(samples)}", file=sys.stderr)
-    return EXIT_OK

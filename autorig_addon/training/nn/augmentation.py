@@ -1,7 +1,8 @@
 """The augmentation every network's training shares: the character turned by
 a small random angle about the up axis and mirrored left-right with
 probability one half, applied to the 3-vector columns of its feature tables
-(a turn or a mirror changes no distance, so no example has to be rebuilt).
+(a turn or a mirror changes no distance, so no example has to be rebuilt);
+and the range the training sets stretch characters by.
 
 The random numbers are drawn in a fixed order (the angle, then the mirror
 coin), so a run with a given seed reproduces.
@@ -12,13 +13,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import torch
+
+from ...core.nn.operations import Array, Operations
 
 #: Largest turn about the up axis applied to a training character (degrees):
 #: inputs are normalised to face -y, so only small deviations remain.
 TURN_DEGREES = 15.0
 #: Probability that a training character is mirrored left-right (x -> -x).
 MIRROR_PROBABILITY = 0.5
+#: Range of the per-axis factors the training sets stretch characters by
+#: (thin and stout, tall and short; each variant is normalised again, so
+#: its distances are computed anew and it is built once, not on the fly).
+STRETCH_RANGE = (0.8, 1.25)
 
 
 def turn_and_mirror(rng: np.random.Generator) -> np.ndarray:
@@ -36,18 +42,19 @@ def turn_and_mirror(rng: np.random.Generator) -> np.ndarray:
     return matrix
 
 
-def turned_columns(columns: torch.Tensor, starts: tuple, matrix: torch.Tensor) -> torch.Tensor:
+def turned_columns(ops: Operations, columns: Array, starts: tuple, matrix: Array) -> Array:
     """``columns`` with each 3-vector starting at a column of ``starts`` turned by ``matrix``.
 
     Parameters
     ----------
-    columns : (..., c) tensor, a feature table (the last axis is the features)
+    ops : Operations of ``columns``' kind (numpy or torch)
+    columns : (..., c) array, a feature table (the last axis is the features)
     starts : tuple of int, increasing first columns of the 3-vectors (positions, normals, ...)
-    matrix : (3, 3) tensor of ``columns``' dtype and device
+    matrix : (3, 3) array of ``columns``' kind, dtype and device
 
     Returns
     -------
-    (..., c) tensor: the vectors ``v @ matrix.T``, every other column as it was.
+    (..., c) array: the vectors ``v @ matrix.T``, every other column as it was.
     """
     pieces, position = [], 0
     for start in starts:
@@ -55,4 +62,4 @@ def turned_columns(columns: torch.Tensor, starts: tuple, matrix: torch.Tensor) -
         pieces.append(columns[..., start:start + 3] @ matrix.T)
         position = start + 3
     pieces.append(columns[..., position:])
-    return torch.cat(pieces, dim=-1)
+    return ops.concat(pieces, -1)

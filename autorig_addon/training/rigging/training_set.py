@@ -15,7 +15,8 @@ and the reference joints the bone and root networks learn to connect.
   vertices around each joint and the caps beyond leaf joints, not the
   vertices halfway along a limb whose nearest joint is far.
 * **Augmentation**: :data:`STRETCHED_VARIANTS` copies per character
-  stretched along each axis by up to :data:`STRETCH_RANGE` (thin and stout,
+  stretched along each axis by factors drawn log-uniformly in
+  :data:`..nn.augmentation.STRETCH_RANGE` (thin and stout,
   tall and short characters), normalised again; turns and mirroring come
   at training time.
 """
@@ -28,28 +29,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dataset.normalise import apply_transform, normalisation_transform
-from ..dataset.sample import CharacterSample
-from ..evaluation.skeleton_metrics import COINCIDENT_JOINT_FRACTION, bone_segments, merge_coincident_joints
-from ..geometry.proxy import simplified_proxy
-from ..geometry.segments import closest_segments
-from ..types import Mesh, Skeleton
-from .joint_features import PROXY_VERTICES, JointGraph, joint_graph
+from ...core.dataset.normalise import apply_transform, normalisation_transform
+from ...core.dataset.sample import CharacterSample
+from ...core.evaluation.skeleton_metrics import COINCIDENT_JOINT_FRACTION, bone_segments, merge_coincident_joints
+from ...core.geometry.proxy import simplified_proxy
+from ...core.geometry.segments import closest_segments
+from ...core.rigging.joint_features import PROXY_VERTICES, JointGraph, joint_graph
+from ...core.types import Mesh, Skeleton
+from ..nn.augmentation import STRETCH_RANGE
 
 #: A vertex votes when its closest bone is at least this share as far as
 #: the joint it moves to (1: on the joint's cross-section).
 ATTENTION_RATIO = 0.95
 #: Stretched copies per character, besides the character itself.
 STRETCHED_VARIANTS = 4
-#: Range of the per-axis stretch factors of those copies.
-STRETCH_RANGE = (0.8, 1.25)
 #: Bumped whenever examples change, so old cached ones are rebuilt.
 EXAMPLE_FORMAT_VERSION = 3
-#: Epochs and Adam's starting learning rate (cosine schedule down to 0) of
-#: each skeleton network's training run unless told: the settings its
-#: shipped weights were trained with (docs/models.md).
-TRAINING_SETTINGS = {"joints": (40, 2e-3), "bones": (1500, 3e-3), "root": (600, 3e-3)}
-
 
 @dataclass(frozen=True)
 class RigExample:

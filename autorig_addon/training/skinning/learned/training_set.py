@@ -6,14 +6,15 @@ Augmentations that change the distances are made here, once per character
 (each variant is normalised again, as an input would be):
 
 * **stretch**: the character scaled along each axis by a factor drawn in
-  :data:`STRETCH_RANGE` (thin, stocky, long characters);
+  :data:`...nn.augmentation.STRETCH_RANGE` (thin, stocky, long
+  characters);
 * **re-pose**: the character posed by its own weights (linear blend
   skinning, :mod:`...skeleton.posing`) with a random share of its bones
   turned, as Puppeteer does, so posed inputs are no surprise.
 
 Turns about the up axis and left-right mirroring do not change any
 distance; the training loop applies them to the feature vectors on the fly
-(:data:`.features.VERTEX_VECTORS` and friends). A uniform scale is undone
+(:data:`...core.skinning.learned.features.VERTEX_VECTORS` and friends). A uniform scale is undone
 by the normalisation, so it needs no example.
 """
 
@@ -26,36 +27,21 @@ from typing import Iterable, Optional
 
 import numpy as np
 
-from ...dataset.cache import cache_root
-from ...dataset.normalise import apply_transform, normalisation_transform
-from ...dataset.sample import CharacterSample
-from ...progress import ProgressCallback, report
-from ...skeleton.posing import pose_matrices, posed_vertices, random_poses
-from ...types import Mesh, Skeleton
-from .features import SkinGraph, candidate_targets
-from .predict import network_graph
+from ....core.dataset.cache import cache_root
+from ....core.dataset.normalise import apply_transform, normalisation_transform
+from ....core.dataset.sample import CharacterSample
+from ....core.progress import ProgressCallback, report
+from ....core.skeleton.posing import pose_matrices, posed_vertices, random_poses
+from ....core.skinning.learned.features import SkinGraph, candidate_targets
+from ....core.skinning.learned.predict import network_graph
+from ....core.types import Mesh, Skeleton
+from ...nn.augmentation import STRETCH_RANGE
 
 #: Bumped whenever the examples' content changes, so old files are rebuilt. 2: volumetric
 #: geodesic distances enter open parts all along their bones.
 EXAMPLE_FORMAT_VERSION = 2
-#: Epochs and Adam's starting learning rate (cosine schedule down to 0) of
-#: each network's training run unless told: the settings its shipped
-#: weights were trained with (each epoch about 155 examples; 8 to 15
-#: minutes per network on one CPU core, docs/models.md). HeterSkinNet at
-#: 2e-3 peaked on the held-out characters at epoch 3 and fell back; at
-#: 5e-4 it went lower. RigNet still improved after 25 epochs.
-TRAINING_SETTINGS = {
-    "rignet": (40, 2e-3),
-    "heterskinnet": (25, 5e-4),
-    "skinningnet": (40, 2e-3),
-}
-#: Adam's starting learning rate of :func:`...nn.training.skin_training.train_network`
-#: when not told.
-DEFAULT_LEARNING_RATE = 2e-3
 #: Stretched variants per character.
 STRETCH_VARIANTS = 2
-#: Range of the per-axis stretch factors.
-STRETCH_RANGE = (0.8, 1.25)
 #: Re-posed variants per character.
 REPOSE_VARIANTS = 2
 #: Share of the deform bones turned in a re-posed variant, and the

@@ -1,0 +1,215 @@
+"""Training the skeleton networks: what ``python -m autorig_addon train rig
+--model NAME`` does.
+
+The training characters of ``data_split.json`` are read from the sample
+cache; their examples with stretched variants are built once or reused
+(:mod:`.training_set`); every :data:`..runs.HOLDOUT_EVERY`-th character
+(sorted by name) is held out to pick the epoch and scored as it is, not on
+its stretched copies. Then :func:`..nn.fit.fit`:
+
+* ``joints``: one character per step, turned by a random angle about the up
+  axis and mirrored with probability one half (:mod:`..nn.augmentation`;
+  the feature columns of :data:`...core.rigging.joint_features.VERTEX_VECTORS`
+  and the targets turn with it). Loss: the L1 distance between each moved
+  vertex and its target joint, plus the binary cross-entropy of the
+  attention against the voting vertices (weighted so voters and non-voters
+  count alike, up to :data:`MAX_VOTER_WEIGHT`). The kept epoch has the
+  lowest held-out CD-J2J of the joints the numpy forward pass and the mean
+  shift at the default bandwidth find.
+* ``bones`` and ``root``: the reference joints of every example, jittered
+  (:data:`JOINT_JITTER`) a few times (:data:`JITTER_COPIES`), give pair and
+  joint features once; full-batch training; the epoch with the lowest
+  held-out loss is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import torch
+
+from ...core.dataset.cache import default_cache_dir, training_samples
+from ...core.evaluation.skeleton_metrics import chamfer_j2j
+from ...core.nn.spec import NetworkSpec
+from ...core.rigging.connectivity import bone_probabilities, root_scores
+from ...core.rigging.joint_features import VERTEX_VECTORS, solid_depth
+from ...core.rigging.networks import rig_network
+from ...core.rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, cluster_joints, graph_votes
+from ...core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
+from ...core.rigging.tree_features import candidate_pairs, pair_features, root_features
+from ..nn.augmentation import turn_and_mirror, turned_columns
+from ..nn.fit import FitRecord, fit
+from ..nn.modules import NetworkModule, as_tensors
+from ..nn.torch_kernels import TORCH
+from ..runs import held_out_names, procedural_samples, start_run, write_weights
+from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
+
+#: Weight of the attention loss beside the offset loss.
+ATTENTION_LOSS_WEIGHT = 0.5
+#: Most a voting vertex's attention loss is weighted over a non-voter's
+#: (the weight is the ratio of non-voters to voters, clamped to [1, this]).
+MAX_VOTER_WEIGHT = 20.0
+#: Standard deviation of the noise added to reference joints when training
+#: the bone and root networks (share of the largest side): predicted joints
+#: are about this far off.
+JOINT_JITTER = 0.01
+#: Jittered copies of each example's joints.
+JITTER_COPIES = 4
+#: Epochs between progress lines (and history entries) of the full-batch networks.
+FULL_BATCH_LOG_EVERY = 100
+
+
+def default_examples_dir(seed: int) -> Path:
+    return default_cache_dir().parent / "rig_examples" / f"v{EXAMPLE_FORMAT_VERSION}" / f"seed{seed}"
+
+
+def clustered_joints(weights: dict, example: RigExample, bandwidth: float, density_threshold: float) -> np.ndarray:
+    """The joints the predictor would find on ``example`` (normalised frame)."""
+    return cluster_joints(graph_votes(weights, example.graph), bandwidth, density_threshold, True)[0]
+
+
+def holdout_j2j(weights: dict, holdout: list, bandwidth: float = DEFAULT_BANDWIDTH,
+                density_threshold: float = DEFAULT_DENSITY_THRESHOLD) -> float:
+    """Mean CD-J2J of the clustered joints over the held-out examples (1 where none is found)."""
+    scores = []
+    for example in holdout:
+        joints = clustered_joints(weights, example, bandwidth, density_threshold)
+        scores.append(chamfer_j2j(joints, example.joints) if len(joints) else 1.0)
+    return float(np.mean(scores))
+
+
+def joint_loss(module: NetworkModule, tensors: tuple, matrix: torch.Tensor) -> torch.Tensor:
+    """The joint network's loss on one example turned by ``matrix``."""
+    graph, vertices, target, attention = tensors
+    turned = replace(graph, vertex_features=turned_columns(TORCH, graph.vertex_features, VERTEX_VECTORS, matrix))
+    offsets, logits = module(turned)
+    moved = vertices @ matrix.T + offsets
+    offset_loss = (moved - target @ matrix.T).abs().sum(dim=1).mean()
+    voters = attention.sum().clamp_min(1.0)
+    balance = (len(attention) - voters) / voters
+    attention_loss = torch.nn.functional.binary_cross_entropy_with_logits(
+        logits, attention, pos_weight=balance.clamp(1.0, MAX_VOTER_WEIGHT))
+    return offset_loss + ATTENTION_LOSS_WEIGHT * attention_loss
+
+
+def train_joint_network(train: list, holdout: list, record: FitRecord) -> dict:
+    """Train the joint network (torch seeded by the caller); returns the kept weights."""
+    rng = np.random.default_rng(record.seed)
+    module = NetworkModule(rig_network("joints")).to(record.device)
+    tensors = [tuple(as_tensors(value, record.device) for value in (
+        example.graph, example.graph.vertices.astype(np.float32), example.target_points, example.attention))
+        for example in train]
+
+    def epoch_losses():
+        for index in rng.permutation(len(tensors)):
+            yield lambda: joint_loss(module, tensors[index], torch.as_tensor(
+                turn_and_mirror(rng), dtype=torch.float32, device=record.device))
+
+    return fit(module, epoch_losses, lambda weights: {"cd_j2j": holdout_j2j(weights, holdout)}, record=record,
+               steps_per_epoch=len(tensors))
+
+
+def _jittered_joints(example: RigExample, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Jittered reference joints, symmetric again on a symmetric character,
+    and each joint's twin (-1: none)."""
+    joints = example.joints + rng.normal(0.0, JOINT_JITTER, example.joints.shape)
+    if mirror_error(example.graph.vertices, 0) > SYMMETRY_TOLERANCE:
+        return joints, np.full(len(joints), -1, dtype=np.int64)
+    # Jitter each twin pair alike (mirrored), as the predictor's symmetric joints are.
+    _, twins = symmetric_joints(example.joints, 2 * JOINT_JITTER)
+    twins = twins[:len(example.joints)]
+    for joint, twin in enumerate(twins):
+        if twin > joint and twin < len(joints):
+            joints[twin] = mirror_points(joints[joint][None])[0]
+        elif twin < 0 and abs(example.joints[joint, 0]) <= 2 * JOINT_JITTER:
+            joints[joint, 0] = 0.0
+    return joints, np.where(twins < len(joints), twins, -1)
+
+
+def connectivity_data(examples: list, rng: np.random.Generator) -> dict:
+    """Pair features and labels, root features and root index, per jittered copy."""
+    pairs_x, pairs_y, roots = [], [], []
+    for example in examples:
+        solid = solid_depth(example.mesh)
+        bones = {(min(a, b), max(a, b)) for b, a in enumerate(example.parents.tolist()) if a >= 0}
+        root = int(np.flatnonzero(example.parents < 0)[0])
+        for _ in range(JITTER_COPIES):
+            joints, twins = _jittered_joints(example, rng)
+            pairs = candidate_pairs(joints)
+            pairs_x.append(pair_features(joints, pairs, solid, twins))
+            pairs_y.append(np.array([(a, b) in bones for a, b in pairs.tolist()], dtype=np.float32))
+            roots.append((root_features(joints, solid), root))
+    return {"pair_features": np.concatenate(pairs_x), "pair_labels": np.concatenate(pairs_y), "roots": roots}
+
+
+def connectivity_loss(spec: NetworkSpec, params: dict, data: dict, device: str) -> torch.Tensor:
+    """The bone network's binary cross-entropy over every pair, or the root
+    network's cross-entropy over each copy's joints."""
+    if spec.name == "bones":
+        logits = spec.forward(TORCH, params, torch.as_tensor(data["pair_features"], device=device))
+        return torch.nn.functional.binary_cross_entropy_with_logits(
+            logits, torch.as_tensor(data["pair_labels"], device=device))
+    losses = [torch.nn.functional.cross_entropy(
+        spec.forward(TORCH, params, torch.as_tensor(features, device=device))[None], torch.tensor([root], device=device))
+        for features, root in data["roots"]]
+    return torch.stack(losses).mean()
+
+
+def connectivity_accuracy(network: str, weights: dict, data: dict) -> float:
+    """Held-out accuracy of the numpy forward: bone pairs classified right, or roots picked right."""
+    if network == "bones":
+        predicted = bone_probabilities(data["pair_features"], weights) > 0.5
+        return float(np.mean(predicted == (data["pair_labels"] > 0.5)))
+    return float(np.mean([int(np.argmax(root_scores(features, weights))) == root for features, root in data["roots"]]))
+
+
+def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, record: FitRecord) -> dict:
+    """Train ``bones`` or ``root`` (torch seeded by the caller); returns the kept weights."""
+    rng = np.random.default_rng(record.seed)
+    module = NetworkModule(spec).to(record.device)
+    train_data, held_data = connectivity_data(train, rng), connectivity_data(holdout, rng)
+    features = train_data["pair_features"] if spec.name == "bones" else np.concatenate(
+        [features for features, _ in train_data["roots"]])
+    module.standardise_from(torch.as_tensor(features, device=record.device))
+
+    def held_loss(weights: dict) -> dict:
+        params = {name: torch.as_tensor(value, device=record.device) for name, value in weights.items()}
+        return {"loss": float(connectivity_loss(spec, params, held_data, record.device))}
+
+    best = fit(module, lambda: [lambda: connectivity_loss(spec, module.params(), train_data, record.device)],
+               held_loss, record=record, steps_per_epoch=1, log_every=FULL_BATCH_LOG_EVERY)
+    record.details["holdout_accuracy"] = connectivity_accuracy(spec.name, best, held_data)
+    return best
+
+
+def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None,
+                     epochs: Optional[int] = None, learning_rate: Optional[float] = None, seed: int = 0,
+                     device: str = "auto", output: Optional[Path] = None, procedural: int = 0) -> FitRecord:
+    """Train ``network`` (``joints``, ``bones`` or ``root``) and write its weights; returns the record.
+
+    ``procedural`` adds the procedural characters of seeds ``0 .. procedural - 1``
+    (exact skeletons) as training characters; they are never held out, so
+    the epoch is still chosen on artists' rigs.
+    """
+    spec = rig_network(network)
+    record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
+                       score_name="cd_j2j" if network == "joints" else "loss")
+    folder = Path(examples_dir or default_examples_dir(seed))
+    examples = build_examples(training_samples(Path(sample_dir)), folder, seed)
+    names = sorted(examples)
+    held_names = held_out_names(names)
+    made = build_examples(procedural_samples(procedural), folder, seed)
+    train = [example for name in names if name not in held_names for example in examples[name]]
+    train += [example for name in sorted(made) for example in made[name]]
+    # Held-out characters are scored as they are, not on their stretched copies.
+    holdout = [examples[name][0] for name in names if name in held_names]
+    record.details.update(train_examples=len(train), holdout=sorted(held_names), procedural=procedural)
+    if network == "joints":
+        weights = train_joint_network(train, holdout, record)
+    else:
+        weights = train_connectivity_network(spec, train, holdout, record)
+    write_weights(spec, weights, record, output)
+    return record

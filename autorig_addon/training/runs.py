@@ -1,0 +1,83 @@
+"""What every training run shares, from cached samples to a shipped weights
+file: the device and threads, which training characters are held out to
+pick the epoch, the procedural characters a run may add, and writing the
+kept weights with the run's record.
+
+Training reads the characters of ``data_split.json`` from the sample cache
+(``.npz``, :mod:`autorig_addon.core.dataset`) alone: no Blender, so it also
+runs on a machine without ``bpy`` (the GPU machine).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Optional
+
+import torch
+
+from ..core.dataset.sample import CharacterSample
+from ..core.errors import InputError
+from ..core.nn.spec import NetworkSpec, forget_shipped_weights
+from ..core.nn.weights_io import save_weights
+from .nn.fit import FitRecord
+
+#: Every this-many-th training character (by sorted name) is held out to
+#: choose the epoch; its variants are not trained on.
+HOLDOUT_EVERY = 6
+#: CPU threads torch trains with: the graphs are small (about 3,000
+#: vertices), and one thread is as fast as two on this machine and never
+#: fights other work for the cores.
+TRAINING_THREADS = 1
+
+
+def pick_device(requested: str) -> str:
+    """``cpu`` or ``cuda`` for a requested device (``auto``: the GPU when torch sees one)."""
+    if requested == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if requested == "cuda" and not torch.cuda.is_available():
+        raise InputError("--device cuda was asked for but torch sees no GPU.")
+    return requested
+
+
+def start_run(spec: NetworkSpec, *, seed: int, device: str, epochs: Optional[int], learning_rate: Optional[float],
+              score_name: str) -> FitRecord:
+    """Seed torch, set its threads and make the run's record: ``epochs`` and
+    ``learning_rate`` default to the spec's training settings."""
+    torch.set_num_threads(TRAINING_THREADS)
+    torch.manual_seed(seed)
+    return FitRecord(spec.name, seed, epochs or spec.training.epochs,
+                     learning_rate or spec.training.learning_rate, pick_device(device), score_name)
+
+
+def held_out_names(names: list[str]) -> set[str]:
+    """The training characters held out to choose the epoch: every
+    :data:`HOLDOUT_EVERY`-th by sorted name."""
+    return set(sorted(names)[::HOLDOUT_EVERY])
+
+
+def procedural_samples(count: int) -> list[CharacterSample]:
+    """The procedural characters of seeds ``0 .. count - 1`` as samples
+    (weights from how each piece was built, :mod:`autorig_addon.core.procedural`);
+    a run trains on them but never holds them out, so the epoch is still
+    chosen on artists' rigs."""
+    from ..core.procedural import generate_character
+
+    samples = []
+    for seed in range(count):
+        character = generate_character(seed)
+        samples.append(CharacterSample.from_character(f"procedural/{character.kind}_{seed}", character.kind,
+                                                      character.mesh, character.skeleton, character.weights))
+    return samples
+
+
+def write_weights(spec: NetworkSpec, weights: dict, record: FitRecord, output: Optional[Path]) -> Path:
+    """Save the kept weights with the run's record (and the software that
+    made them) where the extension reads them, or to ``output``."""
+    spec.check_weights(weights, f"the trained {spec.name} network")
+    destination = Path(output) if output else spec.weights_file
+    destination.parent.mkdir(parents=True, exist_ok=True)
+    metadata = {**record.metadata(), "torch_version": torch.__version__, "python": sys.version.split()[0]}
+    save_weights(str(destination), weights, metadata)
+    forget_shipped_weights()
+    return destination

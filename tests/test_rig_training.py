@@ -1,0 +1,93 @@
+"""Training the skeleton networks (training/rigging/train.py) through the
+shared loop (training/nn/fit.py): tiny runs on procedural characters that
+reproduce with their seed, keep their best epoch and write weights the
+predictor reads."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.nn.spec import shipped_weights
+from autorig_addon.core.nn.weights_io import load_weights
+from autorig_addon.core.rigging.networks import RIG_NETWORKS
+from autorig_addon.training.rigging.training_set import sample_examples
+from geometry_fixtures import procedural_sample
+
+torch = pytest.importorskip("torch")
+pytestmark = pytest.mark.torch
+
+from autorig_addon.training.rigging.train import (  # noqa: E402
+    JITTER_COPIES, connectivity_data, holdout_j2j, train_connectivity_network, train_joint_network,
+)
+from autorig_addon.training.runs import start_run, write_weights  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def one_torch_thread():
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+@pytest.fixture(scope="module")
+def examples():
+    """``(train, holdout)``: one stretched variant of two procedural
+    characters to train on, the third character as it is to hold out."""
+    train = []
+    for seed in (5, 8):
+        train += sample_examples(procedural_sample(seed), np.random.default_rng(seed), variants=1)
+    return train, sample_examples(procedural_sample(4), np.random.default_rng(4), variants=0)
+
+
+def run(name, examples, seed, epochs):
+    record = start_run(RIG_NETWORKS[name], seed=seed, device="cpu", epochs=epochs, learning_rate=None,
+                       score_name="cd_j2j" if name == "joints" else "loss")
+    train, holdout = examples
+    if name == "joints":
+        weights = train_joint_network(train, holdout, record)
+    else:
+        weights = train_connectivity_network(RIG_NETWORKS[name], train, holdout, record)
+    return weights, record
+
+
+def test_a_joint_network_run_reproduces_and_keeps_its_best_epoch(examples):
+    first, record = run("joints", examples, seed=2, epochs=2)
+    second, _ = run("joints", examples, seed=2, epochs=2)
+    assert all(np.array_equal(first[name], second[name]) for name in first)
+    assert [entry["epoch"] for entry in record.history] == [0, 1, 2]
+    scores = [entry["cd_j2j"] for entry in record.history]
+    assert record.best_score == min(scores) and record.best_epoch == scores.index(min(scores))
+    # The kept weights are scored the same by the numpy forward and the mean shift.
+    assert holdout_j2j(first, examples[1]) == pytest.approx(record.best_score, abs=1e-12)
+    assert record.parameters == sum(value.size for value in first.values())
+    RIG_NETWORKS["joints"].check_weights(first, "the run")
+
+
+@pytest.mark.parametrize("name", ["bones", "root"])
+def test_a_full_batch_run_learns_and_reports_its_held_out_accuracy(name, examples):
+    weights, record = run(name, examples, seed=1, epochs=30)
+    again, _ = run(name, examples, seed=1, epochs=30)
+    assert all(np.array_equal(weights[key], again[key]) for key in weights)
+    losses = [entry["loss"] for entry in record.history]
+    # Logged at the start and at the last epoch (every 100 epochs otherwise).
+    assert [entry["epoch"] for entry in record.history] == [0, 30]
+    assert record.best_score <= losses[0] and record.history[-1]["loss"] < losses[0]
+    assert 0.0 <= record.details["holdout_accuracy"] <= 1.0
+    # The standardisation is the training features': each feature's mean over every jittered copy.
+    data = connectivity_data(examples[0], np.random.default_rng(1))
+    features = data["pair_features"] if name == "bones" else np.concatenate([f for f, _ in data["roots"]])
+    np.testing.assert_allclose(weights["input_mean"], features.mean(axis=0), rtol=1e-5, atol=1e-6)
+    assert len(data["roots"]) == JITTER_COPIES * len(examples[0])
+
+
+def test_written_weights_are_what_the_predictor_reads(examples, tmp_path):
+    weights, record = run("root", examples, seed=0, epochs=3)
+    path = write_weights(RIG_NETWORKS["root"], weights, record, tmp_path / "root.npz")
+    loaded = load_weights(str(path))
+    assert all(np.array_equal(loaded.weights[name], weights[name]) for name in weights)
+    assert loaded.metadata["network"] == "root" and loaded.metadata["epochs"] == 3
+    assert loaded.metadata["holdout_accuracy"] == record.details["holdout_accuracy"]
+    assert "torch_version" in loaded.metadata
+    # The shipped weights are untouched by a run written elsewhere.
+    assert not np.array_equal(shipped_weights(RIG_NETWORKS["root"]).weights["mlp.linears.0.weight"],
+                              weights["mlp.linears.0.weight"])
