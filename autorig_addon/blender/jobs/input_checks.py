@@ -1,4 +1,4 @@
-"""What the weighting operators (skin, transfer) check in the same way.
+"""What the weighting jobs (skin, transfer) check in the same way.
 
 - Modes: weights and rest shapes are read from the object data, so Object,
   Pose and Weight Paint Mode are all fine; Edit and Sculpt Mode keep their

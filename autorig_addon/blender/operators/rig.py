@@ -45,7 +45,7 @@ from ..snapshot import restored_on_failure
 from ..ui.properties import (
     REPLACE_BINDING_DESCRIPTION, RIG_OPTION_NAMES, SKIN_OPTION_NAMES, RigOptionProperties, SkinOptionProperties,
 )
-from .input_checks import check_mode, mode_poll
+from ..jobs.input_checks import check_mode, mode_poll
 from .modal_job import ModalJobOperator, WorkerJob, show_job_event
 from .skin import SkinSettings, compute_skin, plan_skin, skin_settings_from, write_skin
 

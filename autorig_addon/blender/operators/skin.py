@@ -41,7 +41,7 @@ from ..scene_io import find_object
 from ..snapshot import restored_on_failure
 from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
 from ..weight_writer import bind_to_bone, write_weights
-from .input_checks import check_mode, mode_poll, split_strays, stray_notes
+from ..jobs.input_checks import check_mode, mode_poll, split_strays, stray_notes
 from .modal_job import ModalJobOperator, WorkerJob, show_job_event
 
 #: When even the deform bone point nearest the mesh's bounding box is

@@ -55,7 +55,7 @@ from ..snapshot import restored_on_failure
 from ..status_attribute import write_status_attribute
 from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties
 from ..weight_writer import bind_to_bone, write_weights
-from .input_checks import check_mode, mode_poll, split_strays, stray_notes
+from ..jobs.input_checks import check_mode, mode_poll, split_strays, stray_notes
 
 
 @dataclass(frozen=True)
