@@ -214,7 +214,7 @@ def test_defaults_are_the_panels_and_the_cores(clean_scene):
     assert (skin.distance.upper(), skin.resolution, skin.max_influences, skin.smoothing_iterations) == (
         settings.skin_distance, settings.skin_resolution, settings.skin_max_influences,
         settings.skin_smoothing_iterations)
-    assert (skin.resolution, skin.distance) == (DEFAULT_RESOLUTION, skinning.DEFAULT_METHOD)
+    assert (skin.resolution, skin.distance) == (DEFAULT_RESOLUTION, skinning.DEFAULT_DISTANCE)
     assert skin.method.upper() == settings.skin_method and skin.method == DEFAULT_SKIN_METHOD
     assert skin.falloff == pytest.approx(settings.skin_falloff) and skin.falloff == skinning.DEFAULT_FALLOFF
     assert skin.smoothing_strength == pytest.approx(settings.skin_smoothing_strength)

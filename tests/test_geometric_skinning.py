@@ -111,11 +111,11 @@ def test_a_vertex_sees_its_nearest_bone_only_when_the_path_is_straight():
 # --------------------------------------------------------------------------- geometric weights
 
 
-@pytest.mark.parametrize("method", ["geodesic", "hollow"])
-def test_two_bone_cylinder_blends_symmetrically_about_the_joint(method):
+@pytest.mark.parametrize("distance", ["geodesic", "hollow"])
+def test_two_bone_cylinder_blends_symmetrically_about_the_joint(distance):
     mesh, skeleton = two_bone_cylinder()
     # Inside a convex shape both distances are the straight ones, exactly.
-    weights = geometric_weights(mesh, skeleton, method=method)
+    weights = geometric_weights(mesh, skeleton, distance=distance)
     reference = geometric_weights(mesh, skeleton, distances=straight_distances(mesh, skeleton))
     np.testing.assert_array_equal(weights.matrix, reference.matrix)
     assert weights.bone_names == ("lower", "upper")
@@ -162,12 +162,12 @@ def test_an_influence_limit_keeps_each_rows_largest_weights():
     np.testing.assert_allclose(limited[two], unlimited[two], atol=1e-12)
 
 
-@pytest.mark.parametrize("method", ["geodesic", "hollow"])
-def test_far_loose_part_binds_wholly_to_its_nearest_bone(method):
+@pytest.mark.parametrize("distance", ["geodesic", "hollow"])
+def test_far_loose_part_binds_wholly_to_its_nearest_bone(distance):
     body, skeleton = two_bone_cylinder()
     prop = box_mesh([-0.1, -0.1, 4.0], [0.1, 0.1, 4.2], 0.05)  # 2 above the top, 3 above 'lower'
     mesh = Mesh.concatenate([body, prop])
-    weights = geometric_weights(mesh, skeleton, method=method)
+    weights = geometric_weights(mesh, skeleton, distance=distance)
     assert_valid(weights, 2)
     np.testing.assert_array_equal(weights.matrix[body.vertex_count:], [[0.0, 1.0]] * prop.vertex_count)
 
@@ -228,7 +228,7 @@ def test_bad_input_is_rejected_with_a_clear_message():
          f"Distances must have one row per vertex and one column per deform bone ({n} x 2), got ({n}, 3)."),
         ({"distances": np.full((n, 2), np.nan)}, "Distances must be finite and non-negative; recompute them."),
         ({"distances": np.full((n, 2), -1.0)}, "Distances must be finite and non-negative; recompute them."),
-        ({"method": "heat"}, "Unknown distance method 'heat'; use one of geodesic, hollow."),
+        ({"distance": "heat"}, "Unknown distance method 'heat'; use one of geodesic, hollow."),
         ({"falloff": 0.0}, "Falloff must be a positive number, got 0.0."),
         ({"max_influences": -1}, "Max influences must be 0 (no limit) or more, got -1."),
         ({"smoothing_iterations": -1}, "Smoothing iterations cannot be negative, got -1."),

@@ -104,7 +104,7 @@ def test_geometric_runs_geometric_weights_with_every_option():
     mesh, skeleton = tube(), two_bone_skeleton(TUBE_HEIGHT)
     chosen = skin_weights(mesh, skeleton, GEOMETRIC, max_influences=1, resolution=RESOLUTION, distance="geodesic",
                           falloff=8.0, smoothing_iterations=2, smoothing_strength=0.3)
-    direct = geometric.geometric_weights(mesh, skeleton, method="geodesic", resolution=RESOLUTION, falloff=8.0,
+    direct = geometric.geometric_weights(mesh, skeleton, distance="geodesic", resolution=RESOLUTION, falloff=8.0,
                                          max_influences=1, smoothing_iterations=2, smoothing_strength=0.3)
     assert chosen.bone_names == direct.bone_names
     np.testing.assert_array_equal(chosen.matrix, direct.matrix)
@@ -146,7 +146,7 @@ def test_each_method_weights_every_vertex_of_a_generated_character_within_the_li
 
 
 def test_ignored_options_are_the_changed_geometric_ones_with_a_network():
-    assert geometric_option_default("distance") == geometric.DEFAULT_METHOD
+    assert geometric_option_default("distance") == geometric.DEFAULT_DISTANCE
     assert geometric_option_default("falloff") == geometric.DEFAULT_FALLOFF
     assert geometric_option_default("smoothing_iterations") == geometric.DEFAULT_SMOOTHING_ITERATIONS
     defaults = {name: geometric_option_default(name) for name in GEOMETRIC_OPTIONS}

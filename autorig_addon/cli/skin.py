@@ -34,10 +34,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     methods = " ".join(f"{name}: {SKIN_METHOD_DESCRIPTIONS[name]}." for name in SKIN_METHODS)
     parser.add_argument("--method", choices=SKIN_METHODS, default=DEFAULT_SKIN_METHOD,
                         help=f"How the weights are computed (default {DEFAULT_SKIN_METHOD}). {methods}")
-    parser.add_argument("--distance", choices=skinning.METHODS, default=skinning.DEFAULT_METHOD,
+    parser.add_argument("--distance", choices=skinning.DISTANCES, default=skinning.DEFAULT_DISTANCE,
                         help=f"{GEOMETRIC_ONLY}. hollow: HollowDist through empty space, reaches bones outside the "
                              "body and loose parts (HeterSkinNet); geodesic: through the inside of the mesh (RigNet) "
-                             f"(default {skinning.DEFAULT_METHOD})")
+                             f"(default {skinning.DEFAULT_DISTANCE})")
     parser.add_argument("--resolution", type=bounded(int, MIN_RESOLUTION, MAX_RESOLUTION), default=DEFAULT_RESOLUTION,
                         help=f"Voxels along the longest side, {MIN_RESOLUTION} to {MAX_RESOLUTION} "
                              f"(default {DEFAULT_RESOLUTION})")

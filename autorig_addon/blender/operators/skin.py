@@ -71,7 +71,7 @@ class SkinSettings:
     """
 
     method: str = DEFAULT_SKIN_METHOD
-    distance: str = skinning.DEFAULT_METHOD
+    distance: str = skinning.DEFAULT_DISTANCE
     resolution: int = DEFAULT_RESOLUTION
     falloff: float = skinning.DEFAULT_FALLOFF
     max_influences: int = skinning.DEFAULT_MAX_INFLUENCES

@@ -186,7 +186,7 @@ class SkinOptionProperties:
     )
     skin_distance: EnumProperty(
         name="Distance", description="How the distance from a vertex to a bone is measured (geometric method only)",
-        items=SKIN_DISTANCE_ITEMS, default=skinning.DEFAULT_METHOD.upper(),
+        items=SKIN_DISTANCE_ITEMS, default=skinning.DEFAULT_DISTANCE.upper(),
     )
     skin_resolution: IntProperty(
         name="Resolution", description="Voxels along the mesh's longest side; higher follows thin parts "

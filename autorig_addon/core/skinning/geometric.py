@@ -72,9 +72,9 @@ from .heat_diffusion import heat_diffusion_weights
 #: Distance kinds: "geodesic" (through the solid; needs closed parts for an
 #: interior, else paths follow the surface) and "hollow" (HollowDist,
 #: through the space the mesh leaves empty; no watertightness needed).
-METHODS = ("geodesic", "hollow")
+DISTANCES = ("geodesic", "hollow")
 #: HollowDist: best on the training characters (see docs/skinning.md).
-DEFAULT_METHOD = "hollow"
+DEFAULT_DISTANCE = "hollow"
 #: Heat strength (Baran & Popovic's c, unitless): how fast a bone's
 #: influence falls off away from the vertices it is nearest to. Higher gives
 #: sharper transitions between bones. 4 was best on the training characters
@@ -105,7 +105,7 @@ def geometric_weights(
     skeleton: Skeleton,
     *,
     distances: np.ndarray | None = None,
-    method: str = DEFAULT_METHOD,
+    distance: str = DEFAULT_DISTANCE,
     resolution: int = DEFAULT_RESOLUTION,
     falloff: float = DEFAULT_FALLOFF,
     max_influences: int = DEFAULT_MAX_INFLUENCES,
@@ -121,8 +121,8 @@ def geometric_weights(
     skeleton : Skeleton; only bones with ``deform`` set get weights
     distances : (n, d) float64 array, optional
         Vertex-to-deform-bone distances in scene units (columns in the order
-        of the deform bones); computed with ``method`` when omitted.
-    method : "geodesic" or "hollow", the distance kind (see :data:`METHODS`)
+        of the deform bones); computed with ``distance`` when omitted.
+    distance : "geodesic" or "hollow", the distance kind (see :data:`DISTANCES`)
     resolution : int, voxel cells along the longest side of the mesh
     falloff : float > 0, heat strength: higher gives sharper blends between bones
     max_influences : int >= 0, bones kept per vertex (0: no limit)
@@ -136,7 +136,7 @@ def geometric_weights(
     is non-negative, sums to 1 and has at most ``max_influences`` non-zeros
     (when that is above 0).
     """
-    _check_options(method, falloff, max_influences, smoothing_iterations, smoothing_strength)
+    _check_options(distance, falloff, max_influences, smoothing_iterations, smoothing_strength)
     deform = deform_bones_of(mesh, skeleton)
     names = tuple(skeleton.names[j] for j in deform)
     heads, tails = skeleton.joints[deform], skeleton.tails[deform]
@@ -149,7 +149,7 @@ def geometric_weights(
         progress = sub_progress(progress, 0.05, 1.0)
     solved = mesh if proxy is None else proxy.mesh
     if distances is None:
-        compute = volumetric_geodesic_distances if method == "geodesic" else hollow_distances
+        compute = volumetric_geodesic_distances if distance == "geodesic" else hollow_distances
         distances = compute(solved, heads, tails, resolution=resolution, progress=sub_progress(progress, 0.0, 0.85))
     elif proxy is not None:
         distances = proxy.average(distances)
@@ -241,9 +241,9 @@ def _checked_distances(distances, vertex_count: int, bone_count: int) -> np.ndar
     return distances
 
 
-def _check_options(method, falloff, max_influences, smoothing_iterations, smoothing_strength) -> None:
-    if method not in METHODS:
-        raise InputError(f"Unknown distance method {method!r}; use one of {', '.join(METHODS)}.")
+def _check_options(distance, falloff, max_influences, smoothing_iterations, smoothing_strength) -> None:
+    if distance not in DISTANCES:
+        raise InputError(f"Unknown distance method {distance!r}; use one of {', '.join(DISTANCES)}.")
     if not (np.isfinite(falloff) and falloff > 0):
         raise InputError(f"Falloff must be a positive number, got {falloff}.")
     if int(max_influences) < 0:

@@ -46,7 +46,7 @@ SKIN_METHOD_DESCRIPTIONS = {
 #: ``SkinSettings`` and on the command line) -> the keyword of
 #: :func:`.geometric.geometric_weights` they set. Networks ignore them.
 GEOMETRIC_OPTIONS = {
-    "distance": "method",
+    "distance": "distance",
     "falloff": "falloff",
     "smoothing_iterations": "smoothing_iterations",
     "smoothing_strength": "smoothing_strength",

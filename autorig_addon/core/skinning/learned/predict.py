@@ -80,7 +80,7 @@ def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str =
     if prior == "heat":
         prior_weights = heat_prior_weights(mesh, skeleton.joints[deform], skeleton.tails[deform], distances)
     else:
-        prior_weights = geometric_weights(mesh, skeleton, distances=distances, method=distance).matrix
+        prior_weights = geometric_weights(mesh, skeleton, distances=distances, distance=distance).matrix
     report(progress, 0.95, "Network inputs")
     return skin_graph(mesh, skeleton, distances, prior_weights)
 
