@@ -136,7 +136,8 @@ def load_character(path: str) -> tuple[Mesh, Skeleton]:
     """Meshes and armature of a ``.glb`` file, through Blender."""
     import bpy
 
-    from autorig_addon.blender.convert import find_armature, read_mesh, read_skeleton
+    from autorig_addon.blender.armature_binding import find_armature
+    from autorig_addon.blender.convert import read_mesh, read_skeleton
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_scene.gltf(filepath=path)

@@ -32,7 +32,8 @@ MAKEHUMAN = os.path.join(REPO, "..", "shared", "data", "makehuman")
 def load_inputs(garment: str):
     import bpy
 
-    from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights
+    from autorig_addon.blender.armature_binding import find_armature
+    from autorig_addon.blender.convert import deform_bone_names, read_mesh, read_weights
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_scene.gltf(filepath=os.path.join(MAKEHUMAN, "body.glb"))

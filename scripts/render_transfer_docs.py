@@ -19,7 +19,8 @@ import sys
 import bpy
 from mathutils import Vector
 
-from autorig_addon.blender.convert import deform_bone_names, find_armature, read_mesh, read_weights
+from autorig_addon.blender.armature_binding import find_armature
+from autorig_addon.blender.convert import deform_bone_names, read_mesh, read_weights
 from autorig_addon.blender.status_attribute import write_status_attribute
 from autorig_addon.blender.weight_writer import write_weights
 from autorig_addon.core.transfer import transfer_weights

@@ -445,6 +445,7 @@ def test_scene_io_rejects_unknown_and_missing_files(clean_scene, tmp_path):
 
 def test_scene_io_fbx_round_trip_and_obj_import(clean_scene, tmp_path):
     from autorig_addon.blender import scene_io
+    from autorig_addon.blender.armature_binding import find_armature
     from autorig_addon.core.errors import InputError
 
     build_rig_scene()
@@ -452,7 +453,7 @@ def test_scene_io_fbx_round_trip_and_obj_import(clean_scene, tmp_path):
     scene_io.load_scene(tmp_path / "rig.fbx")
     body = scene_io.find_object("Body", "MESH")
     assert {LOWER_BONE, UPPER_BONE} <= set(body.vertex_groups.keys())
-    assert convert.find_armature(body).type == "ARMATURE"
+    assert find_armature(body).type == "ARMATURE"
     with pytest.raises(InputError,
                        match="'Body' has type Mesh, expected Armature. Available armature objects: Armature"):
         scene_io.find_object("Body", "ARMATURE")

@@ -8,6 +8,7 @@ import pytest
 from mathutils import Euler, Quaternion, Vector
 
 from autorig_addon.blender import convert
+from autorig_addon.blender.armature_binding import find_armature
 from autorig_addon.core.errors import InputError
 from blender_fixtures import (
     LOWER_BONE,
@@ -169,13 +170,13 @@ def test_deform_bone_names_lists_only_deforming_bones(clean_scene):
 
 def test_find_armature_from_modifier_or_parent(clean_scene):
     rig = build_rig_scene()
-    assert convert.find_armature(rig.body) == rig.armature
+    assert find_armature(rig.body) == rig.armature
     rig.body.modifiers.clear()
-    assert convert.find_armature(rig.body) == rig.armature  # still the parent
+    assert find_armature(rig.body) == rig.armature  # still the parent
     with pytest.raises(InputError, match=re.escape(
             "'Sleeve' is not bound to an armature: give it an Armature modifier "
             "or parent it to the armature (Ctrl+P > With Empty Groups) first.")):
-        convert.find_armature(rig.sleeve)
+        find_armature(rig.sleeve)
 
 
 def test_read_weights_matches_groups_and_fills_missing_with_zero(clean_scene):
@@ -213,7 +214,7 @@ def test_read_weights_of_a_bound_mesh_after_write(clean_scene):
     add_weights(box, [LOWER_BONE], np.ones((8, 1)))
     bind(box, armature)
     bpy.context.view_layer.update()
-    assert convert.find_armature(box) == armature
+    assert find_armature(box) == armature
     np.testing.assert_array_equal(convert.read_weights(box, [LOWER_BONE, UPPER_BONE]).matrix, [[1.0, 0.0]] * 8)
 
 

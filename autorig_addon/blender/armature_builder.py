@@ -14,6 +14,7 @@ from mathutils import Vector
 from ..core.errors import InputError
 from ..core.skeleton.checks import check_buildable, skeleton_extent
 from ..core.types import Skeleton
+from .armature_binding import remove_armature
 
 #: A child whose head sits on its parent's tail (within this fraction of the
 #: skeleton's extent) is connected to it, so grabbing the parent's tail moves the child.
@@ -65,8 +66,7 @@ def build_armature(skeleton: Skeleton, name: str, context=None, collection=None)
         for bone, deform in zip((data.bones[n] for n in skeleton.names), skeleton.deform):
             bone.use_deform = bool(deform)
     except BaseException:
-        bpy.data.objects.remove(obj)
-        bpy.data.armatures.remove(data)
+        remove_armature(obj)
         view_layer.objects.active = previous_active
         raise
     view_layer.objects.active = previous_active

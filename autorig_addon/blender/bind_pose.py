@@ -33,7 +33,8 @@ from ..core.geometry.bounding_box import character_size
 from ..core.io.glb import glb_without_animations, gltf_without_animations
 from ..core.messages import listed_names
 from . import scene_io
-from .characters import choose_armature, rest_position
+from .armature_binding import pose_position
+from .characters import choose_armature
 
 #: A character deforms to itself when no vertex moves farther than this share
 #: of its size (bounding-box diagonal) between the undeformed mesh and the
@@ -176,19 +177,13 @@ def bind_pose_error(armature_obj, mesh_objects: Sequence, measure_pose: bool = T
     size = character_size(undeformed)
     reasons = [reason for obj in mesh_objects for reason in _mesh_reasons(obj)]
     with _only_modifiers_up_to_armature(mesh_objects):
-        with rest_position(armature_obj):
+        with pose_position([armature_obj], "REST"):
             rest_error = _largest_distance([_evaluated_vertices(obj) for obj in mesh_objects], undeformed, size)
         pose_error = float("nan")
         if measure_pose:
-            previous = armature_obj.data.pose_position
-            armature_obj.data.pose_position = "POSE"
-            bpy.context.view_layer.update()
-            try:
+            with pose_position([armature_obj], "POSE"):
                 pose_error = _largest_distance([_evaluated_vertices(obj) for obj in mesh_objects], undeformed, size)
                 moved = _moved_bones(armature_obj, size)
-            finally:
-                armature_obj.data.pose_position = previous
-                bpy.context.view_layer.update()
             if pose_error > BIND_POSE_TOLERANCE and moved:
                 reasons.append(
                     f"the default pose differs from the rest (bind) pose in {len(moved)} bones: {listed_names(moved)}"

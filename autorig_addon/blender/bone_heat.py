@@ -16,7 +16,7 @@ from ..core.errors import InputError
 from ..core.geometry.weld import weld_objects
 from ..core.types import Mesh, Skeleton, Weights
 from . import convert
-from .characters import rest_position
+from .armature_binding import pose_position, remove_armature
 from .scratch_objects import SCRATCH_NAME, remove_scratch_object, scratch_object
 
 
@@ -72,9 +72,7 @@ def _armature_with_tails(armature_obj, skeleton: Skeleton):
     finally:
         if bpy.context.mode != "OBJECT":
             bpy.ops.object.mode_set(mode="OBJECT")
-        bpy.data.objects.remove(rig, do_unlink=True)
-        if data.users == 0:
-            bpy.data.armatures.remove(data)
+        remove_armature(rig)
 
 
 def bone_heat_weights(mesh: Mesh, skeleton: Skeleton, armature_obj) -> Weights:
@@ -112,7 +110,7 @@ def bone_heat_weights(mesh: Mesh, skeleton: Skeleton, armature_obj) -> Weights:
         copies = []
         try:
             copies.extend(scratch_object(part) for part in parts)
-            with rest_position(rig):
+            with pose_position([rig]):
                 for obj in bpy.context.view_layer.objects:
                     obj.select_set(False)
                 for copy in copies:

@@ -15,7 +15,6 @@ command line, tests and batch jobs, not from an artist's open file.
 
 from __future__ import annotations
 
-import contextlib
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -33,6 +32,7 @@ from ..core.skeleton.tails import with_reliable_tails
 from ..core.types import Mesh, Skeleton, Weights
 from ..core.weights import INFLUENCE_EPSILON, normalize_rows
 from . import convert, scene_io
+from .armature_binding import deforms, pose_position
 from .simplify import simplify
 
 
@@ -99,22 +99,13 @@ class RiggedCharacter:
 
 
 def skinned_meshes(armature_obj) -> list:
-    """Mesh objects the armature deforms, in name order: those with an
-    Armature modifier on it, or parented to it with parent type ARMATURE.
+    """Mesh objects of the scene the armature deforms
+    (:func:`.armature_binding.deforms`), in name order.
 
     A mesh parented to the armature object or to one of its bones without
-    either is attached rigidly (a sword, a hat), not skinned.
+    an Armature modifier is attached rigidly (a sword, a hat), not skinned.
     """
-    found = []
-    for obj in bpy.context.scene.objects:
-        if obj.type != "MESH":
-            continue
-        by_modifier = any(
-            modifier.type == "ARMATURE" and modifier.object == armature_obj for modifier in obj.modifiers
-        )
-        by_parent = obj.parent == armature_obj and obj.parent_type == "ARMATURE"
-        if by_modifier or by_parent:
-            found.append(obj)
+    found = [obj for obj in bpy.context.scene.objects if obj.type == "MESH" and deforms(armature_obj, obj)]
     return sorted(found, key=lambda obj: obj.name)
 
 
@@ -157,19 +148,6 @@ def choose_armature() -> tuple:
     return armature, meshes, notes
 
 
-@contextlib.contextmanager
-def rest_position(armature_obj):
-    """Show the armature in its REST position inside the block (restored after)."""
-    previous = armature_obj.data.pose_position
-    armature_obj.data.pose_position = "REST"
-    bpy.context.view_layer.update()
-    try:
-        yield
-    finally:
-        armature_obj.data.pose_position = previous
-        bpy.context.view_layer.update()
-
-
 def read_character(name: str, path: str = "", category: str = "") -> RiggedCharacter:
     """The rigged character of the current scene (see :class:`RiggedCharacter`).
 
@@ -184,7 +162,7 @@ def read_character(name: str, path: str = "", category: str = "") -> RiggedChara
         meshes = [obj for obj in meshes if len(obj.data.polygons)]
         if not meshes:
             raise InputError(f"The meshes skinned to '{armature.name}' have no faces: there is no surface to weight.")
-    with rest_position(armature):
+    with pose_position([armature]):
         mesh = convert.read_mesh(meshes, bpy.context.evaluated_depsgraph_get())
     full_skeleton = convert.read_skeleton(armature)
     deforming = [bone for bone, deforms in zip(full_skeleton.names, full_skeleton.deform) if deforms]

@@ -3,8 +3,8 @@
 Vertices, triangles and bone ends go through ``foreach_get`` into numpy;
 deform weights, which have no ``foreach_get``, through one flat pass over
 the vertices' group memberships. Nothing here changes the objects, except
-that :func:`armatures_at_rest` puts armatures in Rest Position while a
-mesh is read and restores them afterwards.
+that the armatures posing a mesh are shown in Rest Position while it is
+read (:func:`.armature_binding.objects_at_rest`) and restored afterwards.
 
 Writing lives beside this module: :mod:`.weight_writer` (vertex groups and
 the armature binding), :mod:`.status_attribute` (the transfer status
@@ -13,7 +13,6 @@ colours) and :mod:`.snapshot` (undoing a write that fails half-way).
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from typing import Sequence
 
 import bpy
@@ -23,6 +22,7 @@ from mathutils import Matrix
 from ..core.errors import InputError
 from ..core.skeleton.hierarchy import parents_first_order, reindexed_parents
 from ..core.types import Mesh, Skeleton, Weights
+from .armature_binding import objects_at_rest
 
 
 def _as_object_list(objects) -> list:
@@ -123,40 +123,10 @@ def read_mesh(objects, depsgraph=None) -> Mesh:
     object_list = _as_object_list(objects)
     if not object_list:
         raise InputError("No mesh objects given.")
-    with armatures_at_rest(object_list):
+    with objects_at_rest(object_list):
         if depsgraph is None:
             depsgraph = bpy.context.evaluated_depsgraph_get()
         return Mesh.concatenate([_read_one_mesh(obj, depsgraph) for obj in object_list])
-
-
-@contextmanager
-def armatures_at_rest(objects):
-    """Put the armatures deforming ``objects`` (through an Armature modifier,
-    or carrying them on a bone) in Rest Position while the block runs:
-    weights belong to the rest shape, and some files (CesiumMan) import
-    posed. The pose setting is restored afterwards."""
-    armatures = {
-        modifier.object
-        for obj in objects if obj is not None and obj.type == "MESH"
-        for modifier in obj.modifiers
-        if modifier.type == "ARMATURE" and modifier.object is not None
-    }
-    armatures |= {
-        obj.parent for obj in objects
-        if obj is not None and obj.parent is not None and obj.parent.type == "ARMATURE" and obj.parent_type == "BONE"
-    }
-    posed = [armature for armature in armatures if armature.data.pose_position != "REST"]
-    for armature in posed:
-        armature.data.pose_position = "REST"
-    try:
-        if posed:
-            bpy.context.view_layer.update()
-        yield
-    finally:
-        for armature in posed:
-            armature.data.pose_position = "POSE"
-        if posed:
-            bpy.context.view_layer.update()
 
 
 def require_armature_object(obj) -> None:
@@ -251,25 +221,6 @@ def read_weights(obj, bone_names: Sequence[str]) -> Weights:
     """
     require_mesh_object(obj)
     return Weights(read_group_weights(obj, bone_names), tuple(bone_names))
-
-
-def find_armature(mesh_obj):
-    """The armature deforming ``mesh_obj``: its first Armature modifier's
-    object, else its parent when that is an armature.
-
-    Raises
-    ------
-    InputError when there is none.
-    """
-    for modifier in mesh_obj.modifiers:
-        if modifier.type == "ARMATURE" and modifier.object is not None and modifier.object.type == "ARMATURE":
-            return modifier.object
-    if mesh_obj.parent is not None and mesh_obj.parent.type == "ARMATURE":
-        return mesh_obj.parent
-    raise InputError(
-        f"'{mesh_obj.name}' is not bound to an armature: give it an Armature modifier "
-        "or parent it to the armature (Ctrl+P > With Empty Groups) first."
-    )
 
 
 def vertex_group_mask(obj, group_name: str, threshold: float) -> np.ndarray | None:

@@ -4,8 +4,9 @@
   importer's ``Icosphere``), objects hidden from render, objects in no
   rendered collection of the scene. A run never picks them by itself
   (:func:`without_helpers`); named explicitly, they are weighted like any mesh.
-- **Props parented to a bone** (KayKit helmets, swords, shields, capes):
-  already rigged, rigidly. Picked by a run itself they are left as they are;
+- **Props parented to a bone** (KayKit helmets, swords, shields, capes;
+  :func:`.armature_binding.bone_parent`): already rigged, rigidly. Picked
+  by a run itself they are left as they are;
   named or selected, they are bound wholly to that bone and the bone parent
   is replaced by the armature (:class:`RigidBinding`), keeping their rest
   position, so posing moves them exactly as before. A mesh is never both
@@ -24,7 +25,8 @@ from mathutils import Matrix
 
 from ..core.errors import InputError
 from ..core.messages import listed_names
-from .convert import armatures_at_rest, deform_bone_names
+from .armature_binding import bone_parent, objects_at_rest
+from .convert import deform_bone_names
 
 
 @dataclass(frozen=True)
@@ -49,13 +51,6 @@ class RigidBinding:
     def note(self) -> str:
         """What the report says about the object (after its name)."""
         return f"bound wholly to bone '{self.bone}' (it was parented to that bone)"
-
-
-def bone_parent(obj) -> str | None:
-    """Name of the bone ``obj`` is parented to, or None when it has no bone parent."""
-    if obj.parent is not None and obj.parent.type == "ARMATURE" and obj.parent_type == "BONE" and obj.parent_bone:
-        return obj.parent_bone
-    return None
 
 
 def left_rigid_note(obj) -> str:
@@ -84,7 +79,7 @@ def rigid_binding(obj, armature) -> RigidBinding | None:
         )
     if bone not in deform_bone_names(armature):
         return None
-    with armatures_at_rest([obj]):
+    with objects_at_rest([obj]):
         rest_world = obj.matrix_world.copy()
     return RigidBinding(obj, armature, bone, rest_world)
 

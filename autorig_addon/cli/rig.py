@@ -65,7 +65,7 @@ def clear_armatures(replace: bool) -> list[str]:
     the names of the removed armatures."""
     import bpy
 
-    from ..blender.operators.rig import clear_parent_keep_world, remove_armature, unbind
+    from ..blender.armature_binding import clear_parent_keep_world, remove_armature, unbind
 
     armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
     if not armatures:

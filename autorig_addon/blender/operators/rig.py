@@ -39,6 +39,7 @@ from ...core.skeleton.checks import skeleton_extent
 from ...core.skinning.methods import SKIN_METHOD_LABELS
 from ...core.types import Mesh, Skeleton
 from .. import convert
+from ..armature_binding import bound_armature, remove_armature, unbind
 from ..armature_builder import build_armature
 from ..progress import blender_progress
 from ..snapshot import restored_on_failure
@@ -145,18 +146,6 @@ def selected_meshes(context) -> list:
     return sorted((obj for obj in context.selected_objects if obj.type == "MESH"), key=lambda obj: obj.name)
 
 
-def bound_armatures(meshes: list) -> dict:
-    """{mesh: armature} for each of ``meshes`` an armature deforms (an
-    Armature modifier on it, or an armature parent)."""
-    found = {}
-    for obj in meshes:
-        try:
-            found[obj] = convert.find_armature(obj)
-        except InputError:
-            pass
-    return found
-
-
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
              skin: SkinSettings | None = None, replace: bool = False, named: bool = True) -> RigPlan:
     """Read and check the character's meshes; raises :class:`InputError` on bad input.
@@ -179,9 +168,9 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
         convert.require_mesh_object(obj, "mesh to rig")
         check_mode(obj, "rig")
     if skin is not None and not replace:
-        bound = bound_armatures(meshes)
+        bound = [(obj, bound_armature(obj)) for obj in meshes if bound_armature(obj) is not None]
         if bound:
-            obj, armature = next(iter(bound.items()))
+            obj, armature = bound[0]
             raise InputError(
                 f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
                 "it to the new skeleton instead, or remove its Armature modifier first."
@@ -189,39 +178,6 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     mesh = convert.read_mesh(meshes, depsgraph)
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named)
-
-
-def unbind(obj) -> None:
-    """Detach a mesh from the armatures deforming it: its Armature
-    modifiers, its vertex groups named after their bones and an armature
-    parent go; its world transform stays."""
-    armatures = {m.object for m in obj.modifiers if m.type == "ARMATURE" and m.object is not None}
-    if obj.parent is not None and obj.parent.type == "ARMATURE":
-        armatures.add(obj.parent)
-    bone_names = {bone.name for armature in armatures for bone in armature.data.bones}
-    for modifier in [m for m in obj.modifiers if m.type == "ARMATURE"]:
-        obj.modifiers.remove(modifier)
-    for group in [g for g in obj.vertex_groups if g.name in bone_names]:
-        obj.vertex_groups.remove(group)
-    if obj.parent in armatures:
-        clear_parent_keep_world(obj)
-
-
-def clear_parent_keep_world(obj) -> None:
-    """Unparent ``obj`` where it stands."""
-    world = obj.matrix_world.copy()
-    obj.parent = None
-    obj.parent_type = "OBJECT"
-    obj.parent_bone = ""
-    obj.matrix_basis = world
-
-
-def remove_armature(armature) -> None:
-    """Delete an armature object, and its data when nothing else uses it."""
-    data = armature.data
-    bpy.data.objects.remove(armature)
-    if data.users == 0:
-        bpy.data.armatures.remove(data)
 
 
 def _remember(armature, votes: JointVotes) -> None:
@@ -320,8 +276,7 @@ def live_armature(context) -> tuple[object, str]:
         return None, f"'{armature.name}' is in Edit Mode: the settings wait for the next Predict Skeleton"
     if not _unedited(armature, _prediction_of(armature).built):
         return None, f"'{armature.name}' was edited: the settings apply at the next Predict Skeleton"
-    bound = [obj.name for obj in context.scene.objects if obj.type == "MESH"
-             and any(m.type == "ARMATURE" and m.object == armature for m in obj.modifiers)]
+    bound = [obj.name for obj in context.scene.objects if obj.type == "MESH" and bound_armature(obj) == armature]
     if bound:
         return None, f"'{armature.name}' is bound to meshes: the settings apply at the next Predict Skeleton"
     return armature, ""

@@ -18,6 +18,7 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 from ...core.errors import InputError
 from ...core.io.rignet_rig import read_rignet_rig, write_rignet_rig
 from .. import convert
+from ..armature_binding import find_armature, remove_armature
 from ..armature_builder import build_armature
 from ..object_roles import give_own_mesh, shared_mesh_notes
 from ..snapshot import restored_on_failure
@@ -57,9 +58,7 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
             give_own_mesh(mesh_obj)
             write_weights(mesh_obj, weights, armature)
     except BaseException:
-        data = armature.data
-        bpy.data.objects.remove(armature)
-        bpy.data.armatures.remove(data)
+        remove_armature(armature)
         raise
     return armature
 
@@ -142,7 +141,7 @@ class AUTORIG_OT_export_rignet(bpy.types.Operator, ExportHelper):
     def execute(self, context):
         try:
             mesh_obj = _active_mesh(context)
-            armature = convert.find_armature(mesh_obj) if mesh_obj is not None else context.active_object
+            armature = find_armature(mesh_obj) if mesh_obj is not None else context.active_object
             export_rignet_rig(self.filepath, armature, mesh_obj)
         except (InputError, OSError) as error:
             self.report({"ERROR"}, str(error))

@@ -41,9 +41,9 @@ from ...core.transfer.transfer import VertexStatus, transfer_weights
 from ...core.types import Mesh, Weights
 from ...core.weights import normalize_rows
 from .. import convert
+from ..armature_binding import bone_parent, bound_armature, find_armature, is_unbound
 from ..object_roles import (
     RigidBinding,
-    bone_parent,
     give_own_mesh,
     left_rigid_note,
     shared_mesh_notes,
@@ -153,13 +153,7 @@ def split_names(text: str) -> list[str]:
 
 
 def _is_skinned_mesh(obj) -> bool:
-    if obj.type != "MESH" or not len(obj.vertex_groups):
-        return False
-    try:
-        convert.find_armature(obj)
-    except InputError:
-        return False
-    return True
+    return obj.type == "MESH" and len(obj.vertex_groups) > 0 and bound_armature(obj) is not None
 
 
 @dataclass(frozen=True)
@@ -218,19 +212,10 @@ def resolve_source(context, name: str, how: HowToPick = PICK_IN_PANEL):
 
 def unbound_meshes(source) -> list:
     """The meshes a run weights when none is named: every mesh of the file
-    other than ``source`` not yet deformed by an armature (through a modifier
-    or as an armature's object child). Props on a bone are included:
+    other than ``source`` that ``armature_binding.is_unbound``. Props on a bone are included:
     :func:`plan_transfer` with ``named=False`` leaves them rigid and says so,
     and leaves out helper objects."""
-    meshes = []
-    for obj in bpy.data.objects:
-        if obj.type != "MESH" or obj == source:
-            continue
-        modifier_bound = any(m.type == "ARMATURE" and m.object is not None for m in obj.modifiers)
-        child_bound = obj.parent is not None and obj.parent.type == "ARMATURE" and bone_parent(obj) is None
-        if not (modifier_bound or child_bound):
-            meshes.append(obj)
-    return meshes
+    return [obj for obj in bpy.data.objects if obj.type == "MESH" and obj != source and is_unbound(obj)]
 
 
 def resolve_targets(context, names: str, source, extra=None, how: HowToPick = PICK_IN_PANEL) -> list:
@@ -299,7 +284,7 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
         if target == source:
             raise InputError(f"'{source.name}' is both the source and a target: pick a different mesh to weight.")
         check_mode(target, "transfer")
-    armature = convert.find_armature(source)
+    armature = find_armature(source)
     bone_names = convert.deform_bone_names(armature)
     if not bone_names:
         raise InputError(f"The armature '{armature.name}' has no bones with Deform enabled.")
@@ -586,7 +571,7 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             source = resolve_source(context, self.source, how)
             targets = resolve_targets(context, self.targets, source, how=how)
             depsgraph = context.evaluated_depsgraph_get()
-            settings = self._settings(convert.find_armature(source))
+            settings = self._settings(find_armature(source))
             with blender_progress(context, "Transfer weights") as progress:
                 outcomes = run_transfer(source, targets, settings, depsgraph, progress)
         except InputError as error:
