@@ -446,24 +446,25 @@ def test_scene_io_rejects_unknown_and_missing_files(clean_scene, tmp_path):
 def test_scene_io_fbx_round_trip_and_obj_import(clean_scene, tmp_path):
     from autorig_addon.blender import scene_io
     from autorig_addon.blender.armature_binding import find_armature
+    from autorig_addon.blender.selection import find_object
     from autorig_addon.core.errors import InputError
 
     build_rig_scene()
     scene_io.save_scene(tmp_path / "rig.fbx")
     scene_io.load_scene(tmp_path / "rig.fbx")
-    body = scene_io.find_object("Body", "MESH")
+    body = find_object("Body", "MESH")
     assert {LOWER_BONE, UPPER_BONE} <= set(body.vertex_groups.keys())
     assert find_armature(body).type == "ARMATURE"
     with pytest.raises(InputError,
                        match="'Body' has type Mesh, expected Armature. Available armature objects: Armature"):
-        scene_io.find_object("Body", "ARMATURE")
+        find_object("Body", "ARMATURE")
 
     (tmp_path / "triangle.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     scene_io.load_scene(tmp_path / "triangle.obj")
     meshes = [obj for obj in bpy.data.objects if obj.type == "MESH"]
     assert len(meshes) == 1 and len(meshes[0].data.vertices) == 3
     with pytest.raises(InputError, match=f"No object named 'Body'. Available: {meshes[0].name}"):
-        scene_io.find_object("Body")
+        find_object("Body")
 
 
 # --------------------------------------------------------------------------- bad input reported early and plainly

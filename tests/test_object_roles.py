@@ -12,7 +12,8 @@ import pytest
 
 from autorig_addon.blender import object_roles, status_attribute
 from autorig_addon.blender.operators import transfer as transfer_operators
-from autorig_addon.blender.operators.transfer import TransferSettings, run_transfer, unbound_meshes
+from autorig_addon.blender.operators.transfer import TransferSettings, run_transfer
+from autorig_addon.blender.selection import unbound_meshes
 from autorig_addon.core.errors import InputError
 from blender_fixtures import (
     BODY_RADIUS,

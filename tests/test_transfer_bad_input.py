@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import convert
-from autorig_addon.blender.operators.transfer import PICK_IN_PANEL, resolve_source, resolve_targets, scene_defaults
+from autorig_addon.blender.operators.transfer import scene_defaults
+from autorig_addon.blender.selection import PICK_IN_PANEL, resolve_source, resolve_targets
 from autorig_addon.blender.status_attribute import STATUS_ATTRIBUTE
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.transfer.transfer import VertexStatus

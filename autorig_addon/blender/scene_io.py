@@ -10,9 +10,6 @@ import bpy
 from ..core.errors import InputError
 from ..core.io.scene_formats import LOADABLE_EXTENSIONS, SAVABLE_EXTENSIONS
 
-#: Most object names listed in a "no such object" message.
-MAX_LISTED_NAMES = 40
-
 
 def _extension(path: str | os.PathLike) -> str:
     return Path(path).suffix.lower()
@@ -85,24 +82,3 @@ def save_scene(path: str | os.PathLike) -> None:
         )
     else:
         bpy.ops.export_scene.fbx(filepath=filepath, add_leaf_bones=False, use_armature_deform_only=False)
-
-
-def find_object(name: str, object_type: str | None = None):
-    """The object called ``name`` (optionally of ``object_type``, e.g. 'MESH').
-
-    Raises
-    ------
-    InputError naming the objects that do exist.
-    """
-    obj = bpy.data.objects.get(name)
-    if obj is not None and (object_type is None or obj.type == object_type):
-        return obj
-    candidates = sorted(o.name for o in bpy.data.objects if object_type is None or o.type == object_type)
-    listed = ", ".join(candidates[:MAX_LISTED_NAMES]) + (" ..." if len(candidates) > MAX_LISTED_NAMES else "")
-    kind = f"{object_type.lower()} object" if object_type else "object"
-    if obj is not None:
-        raise InputError(
-            f"'{name}' has type {obj.type.title()}, expected {object_type.title()}. "
-            f"Available {kind}s: {listed or 'none'}."
-        )
-    raise InputError(f"No {kind} named '{name}'. Available: {listed or 'none'}.")

@@ -66,6 +66,7 @@ def clear_armatures(replace: bool) -> list[str]:
     import bpy
 
     from ..blender.armature_binding import clear_parent_keep_world, remove_armature, unbind
+    from ..blender.selection import file_meshes
 
     armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
     if not armatures:
@@ -74,9 +75,8 @@ def clear_armatures(replace: bool) -> list[str]:
     if not replace:
         raise InputError(f"The file already holds an armature ({listed_names(names, quoted=True)}): pass --replace "
                          "to remove it and rig the meshes anew.")
-    for obj in bpy.data.objects:
-        if obj.type == "MESH":
-            unbind(obj)
+    for obj in file_meshes():
+        unbind(obj)
     for obj in bpy.data.objects:
         if obj.parent in armatures:
             clear_parent_keep_world(obj)
@@ -97,10 +97,11 @@ def run(args: argparse.Namespace) -> int:
 
         from ..blender import scene_io
         from ..blender.object_roles import without_helpers
+        from ..blender.selection import file_meshes
 
         scene_io.load_scene(input_path)
         # Helpers (bone shapes) are told apart while their armature is still there.
-        meshes = without_helpers([obj for obj in bpy.data.objects if obj.type == "MESH"])
+        meshes = without_helpers(file_meshes())
         removed = clear_armatures(args.replace)
         if not meshes:
             raise InputError("The file holds no mesh to rig.")

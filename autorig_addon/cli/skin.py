@@ -12,7 +12,6 @@ import dataclasses
 import sys
 
 from ..core.distances.grid import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
-from ..core.errors import InputError
 from ..core.skinning import geometric as skinning
 from ..core.skinning.methods import (
     DEFAULT_SKIN_METHOD, GEOMETRIC, GEOMETRIC_OPTIONS, SKIN_METHOD_DESCRIPTIONS, SKIN_METHODS, ignored_options,
@@ -52,38 +51,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Remove every existing vertex group first (default: only the deform bones' groups)")
 
 
-def split_mesh_names(mesh_names: list[str]) -> list[str]:
-    """The mesh names of repeated or comma-separated ``--mesh`` options."""
-    from ..blender.operators.transfer import split_names
-
-    return [name for text in mesh_names for name in split_names(text)]
-
-
-def skin_objects(armature_name: str, mesh_names: list[str]):
-    """The armature and meshes a skin run binds, from names or the file's content."""
-    import bpy
-
-    from ..blender import scene_io
-
-    if armature_name:
-        armature = scene_io.find_object(armature_name, "ARMATURE")
-    else:
-        armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
-        if len(armatures) != 1:
-            found = ", ".join(obj.name for obj in armatures) or "none"
-            raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
-        armature = armatures[0]
-    names = split_mesh_names(mesh_names)
-    if names:
-        return armature, [scene_io.find_object(name, "MESH") for name in names]
-    # Every mesh: the plan (named=False) leaves out helpers such as bone shapes
-    # and leaves props parented to a bone rigid.
-    meshes = [obj for obj in bpy.data.objects if obj.type == "MESH"]
-    if not meshes:
-        raise InputError("The file holds no mesh to skin.")
-    return armature, meshes
-
-
 def ignored_options_note(args: argparse.Namespace) -> str:
     """The note printed when options of the geometric method alone were
     changed with a network, "" otherwise."""
@@ -107,11 +74,12 @@ def run(args: argparse.Namespace) -> int:
         import bpy
 
         from ..blender import scene_io
+        from ..blender.selection import names_in, skin_objects
 
         scene_io.load_scene(input_path)
         armature, meshes = skin_objects(args.armature, args.mesh)
         plan = plan_skin(armature, meshes, settings, bpy.context.evaluated_depsgraph_get(),
-                         named=bool(split_mesh_names(args.mesh)))
+                         named=bool(names_in(args.mesh)))
         weights = compute_skin(plan, progress)
         write_skin(plan, weights)
         progress(1.0, "Saving")

@@ -79,7 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def transfer_settings(args: argparse.Namespace):
     """The operator's ``TransferSettings`` from parsed arguments (whose
     destinations are named after the ``TransferOptions`` fields)."""
-    from ..blender.operators.transfer import TransferSettings, split_names
+    from ..blender.operators.transfer import TransferSettings
+    from ..blender.selection import split_names
 
     replace = args.replace or ("mix" if args.mix is not None else DEFAULT_REPLACE_CHOICE)
     options = TransferOptions(**{field.name: getattr(args, field.name) for field in dataclasses.fields(TransferOptions)})
@@ -94,10 +95,9 @@ def transfer_settings(args: argparse.Namespace):
 
 
 def default_targets(source) -> list:
-    """Every mesh other than ``source`` not yet bound to an armature (props
-    parented to a bone included: the transfer leaves them rigid and says so;
-    helper objects such as bone shapes are left out by the transfer)."""
-    from ..blender.operators.transfer import unbound_meshes
+    """The meshes a transfer weights when none is named
+    (``selection.unbound_meshes``), refusing a file where there is none."""
+    from ..blender.selection import unbound_meshes
 
     targets = unbound_meshes(source)
     if not targets:
@@ -110,12 +110,13 @@ def transfer_file(args: argparse.Namespace, settings, input_path: Path, output_p
     import bpy
 
     from ..blender import scene_io
-    from ..blender.operators.transfer import run_transfer, split_names
+    from ..blender.operators.transfer import run_transfer
+    from ..blender.selection import find_object, names_in
 
     scene_io.load_scene(input_path)
-    source = scene_io.find_object(args.source, "MESH")
-    names = [name for text in args.target for name in split_names(text)]
-    targets = [scene_io.find_object(name, "MESH") for name in names] if names else default_targets(source)
+    source = find_object(args.source, "MESH")
+    names = names_in(args.target)
+    targets = [find_object(name, "MESH") for name in names] if names else default_targets(source)
     outcomes = run_transfer(source, targets, settings, bpy.context.evaluated_depsgraph_get(), progress,
                             named=bool(names))
     progress(1.0, "Saving")

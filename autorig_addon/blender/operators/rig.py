@@ -42,6 +42,7 @@ from .. import convert
 from ..armature_binding import bound_armature, remove_armature, unbind
 from ..armature_builder import build_armature
 from ..progress import blender_progress
+from ..selection import character_name, selected_meshes
 from ..snapshot import restored_on_failure
 from ..ui.properties import (
     REPLACE_BINDING_DESCRIPTION, RIG_OPTION_NAMES, SKIN_OPTION_NAMES, RigOptionProperties, SkinOptionProperties,
@@ -134,16 +135,6 @@ class _Prediction:
 
 
 _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
-
-
-def character_name(meshes: list, active=None) -> str:
-    """The character's name: the active mesh's if it is one of ``meshes``, else the first's."""
-    return (active if active in meshes else meshes[0]).name
-
-
-def selected_meshes(context) -> list:
-    """The selected mesh objects, by name (the order is the selection's otherwise)."""
-    return sorted((obj for obj in context.selected_objects if obj.type == "MESH"), key=lambda obj: obj.name)
 
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,

@@ -37,7 +37,7 @@ from ...core.geometry.outliers import require_finite_positions, rows_for_strays
 from .. import convert
 from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
 from ..progress import blender_progress
-from ..scene_io import find_object
+from ..selection import resolve_skin_inputs
 from ..snapshot import restored_on_failure
 from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
 from ..weight_writer import bind_to_bone, write_weights
@@ -225,29 +225,6 @@ def write_skin(plan: SkinPlan, weights: Weights) -> None:
         for binding in plan.rigid:
             give_own_mesh(binding.obj)
             bind_to_bone(binding.obj, binding.armature, binding.bone, binding.rest_world)
-
-
-def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
-    """The armature and meshes to skin: named ones, else the selection
-    (the active or selected armature and the selected meshes)."""
-    from .transfer import split_names
-
-    if armature_name:
-        armature = find_object(armature_name, "ARMATURE")
-    else:
-        armatures = [obj for obj in context.selected_objects if obj.type == "ARMATURE"]
-        active = context.active_object
-        if active is not None and active.type == "ARMATURE":
-            armature = active
-        elif len(armatures) == 1:
-            armature = armatures[0]
-        else:
-            raise InputError("Select one armature (and the meshes to skin), or name it.")
-    if mesh_names.strip():
-        meshes = [find_object(name, "MESH") for name in split_names(mesh_names)]
-    else:
-        meshes = [obj for obj in context.selected_objects if obj.type == "MESH"]
-    return armature, meshes
 
 
 def skin_settings_from(props) -> SkinSettings:

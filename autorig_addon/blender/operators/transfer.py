@@ -41,7 +41,7 @@ from ...core.transfer.transfer import VertexStatus, transfer_weights
 from ...core.types import Mesh, Weights
 from ...core.weights import normalize_rows
 from .. import convert
-from ..armature_binding import bone_parent, bound_armature, find_armature, is_unbound
+from ..armature_binding import bone_parent, find_armature
 from ..object_roles import (
     RigidBinding,
     give_own_mesh,
@@ -51,6 +51,10 @@ from ..object_roles import (
     without_helpers,
 )
 from ..progress import blender_progress
+from ..selection import (
+    PICK_IN_PANEL, PICK_IN_SCRIPT, HowToPick, object_named, resolve_source, resolve_targets, selected_pose_bone_names,
+    selected_targets, split_names,
+)
 from ..snapshot import restored_on_failure
 from ..status_attribute import write_status_attribute
 from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties
@@ -136,104 +140,6 @@ class TargetOutcome:
     rigid: RigidBinding | None = None
 
 
-# --------------------------------------------------------------------------- object lookup
-
-
-def _object_named(name: str):
-    obj = bpy.data.objects.get(name)
-    if obj is None:
-        meshes = sorted(o.name for o in bpy.data.objects if o.type == "MESH")
-        raise InputError(f"There is no object named '{name}'. Mesh objects here: {', '.join(meshes) or 'none'}.")
-    return obj
-
-
-def split_names(text: str) -> list[str]:
-    """Names from a comma-separated string, blanks dropped."""
-    return [name.strip() for name in text.split(",") if name.strip()]
-
-
-def _is_skinned_mesh(obj) -> bool:
-    return obj.type == "MESH" and len(obj.vertex_groups) > 0 and bound_armature(obj) is not None
-
-
-@dataclass(frozen=True)
-class HowToPick:
-    """How refusals tell the user to name the source and the targets, which
-    depends on how the transfer was started.
-
-    Attributes
-    ----------
-    source : str, completes "make the body the active object or ..."
-    targets : str, completes "select the meshes to weight together with the source, or ..."
-    """
-
-    source: str
-    targets: str
-
-
-#: From the AutoRig panel's button (the operator's ``invoke``).
-PICK_IN_PANEL = HowToPick("pick it as Source in the AutoRig panel", "pick a Target in the AutoRig panel")
-#: From a script (``bpy.ops.autorig.transfer_weights(...)`` runs ``execute``
-#: alone, so the panel's Source and Target are not read).
-PICK_IN_SCRIPT = HowToPick(
-    "pass it by name (bpy.ops.autorig.transfer_weights(source='Body', ...))",
-    "pass them by name (bpy.ops.autorig.transfer_weights(targets='Shirt,Trousers', ...))",
-)
-
-
-def resolve_source(context, name: str, how: HowToPick = PICK_IN_PANEL):
-    """The source object: ``name`` if given, else the active skinned mesh,
-    else the only skinned mesh among the selected objects; refusals say
-    how to name it the way ``how`` describes."""
-    names = split_names(name)
-    if len(names) > 1:
-        raise InputError(
-            f"Several sources were given ({', '.join(names)}): transfer from one body at a time, "
-            "or join the body meshes into one object first."
-        )
-    if names:
-        source = _object_named(names[0])
-        convert.require_mesh_object(source, "source")
-        return source
-    active = context.view_layer.objects.active
-    selected = list(context.selected_objects)
-    if active is not None and active in selected and _is_skinned_mesh(active):
-        return active
-    candidates = [obj for obj in selected if _is_skinned_mesh(obj)]
-    if len(candidates) > 1:
-        raise InputError(
-            f"Several selected meshes are skinned ({', '.join(sorted(o.name for o in candidates))}): "
-            f"make the body the active object or {how.source}."
-        )
-    if not candidates:
-        raise InputError(f"No source: make the skinned body the active object or {how.source}.")
-    return candidates[0]
-
-
-def unbound_meshes(source) -> list:
-    """The meshes a run weights when none is named: every mesh of the file
-    other than ``source`` that ``armature_binding.is_unbound``. Props on a bone are included:
-    :func:`plan_transfer` with ``named=False`` leaves them rigid and says so,
-    and leaves out helper objects."""
-    return [obj for obj in bpy.data.objects if obj.type == "MESH" and obj != source and is_unbound(obj)]
-
-
-def resolve_targets(context, names: str, source, extra=None, how: HowToPick = PICK_IN_PANEL) -> list:
-    """Target objects: the comma-separated ``names``, or when empty the
-    selected meshes other than ``source`` plus ``extra`` (may be None);
-    a refusal says how to name them the way ``how`` describes."""
-    if split_names(names):
-        targets = [_object_named(name) for name in split_names(names)]
-    else:
-        targets = [obj for obj in context.selected_objects if obj.type == "MESH" and obj != source]
-        if extra is not None and extra not in targets and extra != source:
-            targets.append(extra)
-    unique = list(dict.fromkeys(targets))
-    if not unique:
-        raise InputError(f"No target: select the meshes to weight together with the source, or {how.targets}.")
-    return unique
-
-
 # --------------------------------------------------------------------------- plan / compute / write
 
 
@@ -263,7 +169,7 @@ def plan_transfer(source, targets: list, settings: TransferSettings, depsgraph, 
     depsgraph : bpy.types.Depsgraph
     named : bool
         True when the user named or selected ``targets``; False when the run
-        picked them itself (:func:`unbound_meshes`): helper objects are then
+        picked them itself (``selection.unbound_meshes``): helper objects are then
         left out and props on a bone left rigid.
 
     Raises
@@ -458,19 +364,6 @@ def run_transfer(source, targets: list, settings: TransferSettings, depsgraph, p
 # --------------------------------------------------------------------------- operators
 
 
-def selected_pose_bone_names(armature) -> tuple:
-    """Names of the armature's selected pose bones (Blender 4.2 to 5.x)."""
-    names = []
-    for pose_bone in armature.pose.bones:
-        # Blender 5 stores bone selection on the pose bone, 4.x on the bone.
-        selected = getattr(pose_bone, "select", None)
-        if selected is None:
-            selected = pose_bone.bone.select
-        if selected:
-            names.append(pose_bone.name)
-    return tuple(names)
-
-
 def scene_defaults(context, is_set) -> dict:
     """Operator property values taken from the scene settings (``scene.autorig``).
 
@@ -493,11 +386,7 @@ def scene_defaults(context, is_set) -> dict:
     if not is_set("source") and settings.source is not None:
         values["source"] = settings.source.name
     if not is_set("targets"):
-        source_name = values.get("source", "")
-        chosen = [obj for obj in context.selected_objects if obj.type == "MESH" and obj.name != source_name]
-        extra = settings.target
-        if extra is not None and extra not in chosen and extra.name != source_name:
-            chosen.append(extra)
+        chosen = selected_targets(context.selected_objects, values.get("source", ""), settings.target)
         values["targets"] = ",".join(obj.name for obj in chosen)
     return values
 
@@ -608,7 +497,7 @@ class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
 
     def _target(self, context):
         if self.target:
-            obj = _object_named(self.target)
+            obj = object_named(self.target)
         else:
             settings = getattr(context.scene, "autorig", None)
             obj = settings.target if settings is not None and settings.target is not None else context.view_layer.objects.active

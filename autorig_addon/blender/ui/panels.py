@@ -3,9 +3,10 @@
 import bpy
 
 from ...core.skinning.methods import GEOMETRIC
-from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton, live_note, selected_meshes
+from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton, live_note
 from ..operators.skin import AUTORIG_OT_skin_weights
 from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
+from ..selection import selected_meshes, selected_targets
 
 #: Sidebar tab the add-on's panels live in.
 SIDEBAR_CATEGORY = "AutoRig"
@@ -23,15 +24,6 @@ class VIEW3D_PT_autorig(bpy.types.Panel):
 
     def draw(self, context):
         self.layout.label(text="Automatic rigging, skinning and weight transfer", icon="ARMATURE_DATA")
-
-
-def _target_names(context, settings) -> list[str]:
-    """Names of the meshes a transfer would weight, as the operator picks them."""
-    source = settings.source
-    names = [obj.name for obj in context.selected_objects if obj.type == "MESH" and obj != source]
-    if settings.target is not None and settings.target != source and settings.target.name not in names:
-        names.append(settings.target.name)
-    return names
 
 
 def _short_list(names: list[str]) -> str:
@@ -67,7 +59,7 @@ class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
         column = layout.column(align=True)
         column.prop(settings, "source")
         column.prop(settings, "target")
-        targets = _target_names(context, settings)
+        targets = [obj.name for obj in selected_targets(context.selected_objects, settings.source, settings.target)]
         if targets:
             column.label(text=f"Targets: {_short_list(targets)}", icon="MESH_DATA")
         else:
