@@ -13,11 +13,12 @@ already imported cannot hide an import.
 """
 
 import ast
-import importlib.util
 import json
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 from autorig_addon import packaging
 
@@ -69,19 +70,23 @@ def import_everything(repository_root, packages, watched, register=False, skippe
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
-def test_every_core_and_training_module_imports_without_bpy(repository_root):
-    # The training modules where torch is installed to import them (the torch-free pass leaves them out).
-    torch_present = importlib.util.find_spec("torch") is not None
-    packages = ["autorig_addon.core"] + ([TRAINING_MODULE] if torch_present else [])
-    outcome = import_everything(repository_root, packages, ["bpy", "mathutils", "bmesh"])
+def test_every_core_module_imports_without_bpy(repository_root):
+    outcome = import_everything(repository_root, ["autorig_addon.core"], ["bpy", "mathutils", "bmesh"])
     assert outcome["loaded"] == []
     # The walk reached the sub-packages' modules, not only the top level.
     assert {"autorig_addon.core.transfer.transfer", "autorig_addon.core.transfer.options",
             "autorig_addon.core.transfer.combine", "autorig_addon.core.weights",
             "autorig_addon.core.errors", "autorig_addon.core.nn.graph",
             "autorig_addon.core.skinning.learned.networks.heterskinnet"} <= set(outcome["modules"])
-    if torch_present:
-        assert {TRAINING_MODULE + ".nn.torch_kernels", TRAINING_MODULE + ".rigging.train"} <= set(outcome["modules"])
+
+
+@pytest.mark.torch
+def test_every_training_module_imports_without_bpy(repository_root):
+    pytest.importorskip("torch")
+    outcome = import_everything(repository_root, [TRAINING_MODULE], ["bpy", "mathutils", "bmesh"])
+    assert outcome["loaded"] == []
+    assert {TRAINING_MODULE + ".nn.torch_kernels", TRAINING_MODULE + ".rigging.train",
+            TRAINING_MODULE + ".command"} <= set(outcome["modules"])
 
 
 def test_core_blender_and_register_never_import_torch(repository_root):

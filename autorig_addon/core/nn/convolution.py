@@ -16,7 +16,8 @@ vertices).
 
 RigNet's GMEdgeConv block (:func:`gmedge_block`) runs two EdgeConvs, over
 the mesh one-ring and over geodesic balls, and fuses them with a residual;
-the skinning and the joint networks both stack it. SkinningNet's
+RigNet's trunk (:func:`gmedge_trunk`: an encoder, stacked blocks and a
+max-pooled shape code) carries both its skinning and its joint network. SkinningNet's
 multi-aggregator convolution (:func:`multi_aggregator_convolution`) pools
 the same messages several ways. Their parameter layouts are
 :class:`.spec.GMEdge` and :class:`.spec.MultiAggregator`.
@@ -108,6 +109,32 @@ def gmedge_block(ops: Operations, params: dict, x: Array, mesh_edges: Array, bal
     one_ring = edge_convolution(ops, params, x, mesh_edges, prefix + "one_ring.", activation=activation)
     ball = edge_convolution(ops, params, x, ball_edges, prefix + "ball.", activation=activation)
     return x + mlp(ops, params, ops.concat([one_ring, ball], 1), prefix + "fuse.", activation=activation)
+
+
+def gmedge_trunk(ops: Operations, params: dict, x: Array, mesh_edges: Array, ball_edges: Array, blocks: tuple, *,
+                 activation: str) -> Array:
+    """RigNet's trunk: the MLP ``"encoder."``, the GMEdgeConv ``blocks`` in
+    turn, and a shape code (the MLP ``"shape."`` of the last features,
+    max-pooled over every node); its layout is :class:`.spec.GMEdgeTrunk`.
+
+    Parameters
+    ----------
+    x : (n, in) float array, node features
+    mesh_edges, ball_edges : (2, e), (2, b) int arrays, as :func:`gmedge_block`
+    blocks : tuple of str, the blocks' names (``("gmedge1", "gmedge2")``)
+
+    Returns
+    -------
+    (n, (len(blocks) + 1) * c + s) float array: the encoder's and every
+    block's features side by side, then the shape code on every row.
+    """
+    x = mlp(ops, params, x, "encoder.", activation=activation)
+    levels = [x]
+    for block in blocks:
+        x = gmedge_block(ops, params, x, mesh_edges, ball_edges, block + ".", activation=activation)
+        levels.append(x)
+    shape = ops.column_max(mlp(ops, params, x, "shape.", activation=activation))
+    return ops.concat(levels + [ops.repeat_rows(shape, x.shape[0])], 1)
 
 
 def multi_aggregator_convolution(ops: Operations, params: dict, x: Array, edges: Array, prefix: str, *,

@@ -58,3 +58,9 @@ def standardised(params: dict, features: Array) -> Array:
     """Features standardised by the training data's ``input_mean`` and
     ``input_std`` (the :class:`.spec.Standardiser` of a network)."""
     return (features - params["input_mean"]) / params["input_std"]
+
+
+def standardised_scores(ops: Operations, params: dict, features: Array, *, activation: str = "leaky_relu") -> Array:
+    """(r,) one raw score per row of (r, f) features: the MLP ``"mlp."`` on
+    the standardised features (:class:`.spec.StandardisedMLP`)."""
+    return mlp(ops, params, standardised(params, features), "mlp.", activation=activation, activate_last=False)[:, 0]

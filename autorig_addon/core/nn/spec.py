@@ -63,6 +63,28 @@ class GMEdge:
 
 
 @dataclass(frozen=True)
+class GMEdgeTrunk:
+    """RigNet's trunk (:func:`.convolution.gmedge_trunk`): the encoder
+    ``encoder`` from ``in_width`` through ``2 * width`` to ``width``
+    features, GMEdgeConv ``blocks`` of ``width``, and the shape code
+    ``shape`` of ``shape_width``; :attr:`out_width` features per node."""
+
+    in_width: int
+    width: int
+    blocks: tuple
+    shape_width: int
+
+    @property
+    def out_width(self) -> int:
+        return (len(self.blocks) + 1) * self.width + self.shape_width
+
+    def parts(self) -> tuple:
+        return (Dense("encoder", (self.in_width, 2 * self.width, self.width)),
+                *(part for block in self.blocks for part in GMEdge(block, self.width).parts()),
+                Dense("shape", (self.width, self.shape_width)))
+
+
+@dataclass(frozen=True)
 class MultiAggregator:
     """SkinningNet's convolution (:func:`.convolution.multi_aggregator_convolution`)
     from ``in_width`` features through message widths ``widths``: the
@@ -92,6 +114,18 @@ class Scalar:
 
 
 @dataclass(frozen=True)
+class StandardisedMLP:
+    """An MLP ``mlp`` of widths ``[features, hidden..., 1]`` on features
+    standardised by a :class:`Standardiser` (:func:`.layers.standardised_scores`)."""
+
+    features: int
+    widths: tuple
+
+    def parts(self) -> tuple:
+        return (Standardiser(self.features), Dense("mlp", (self.features, *self.widths)))
+
+
+@dataclass(frozen=True)
 class Standardiser:
     """The training data's per-feature mean and spread (``input_mean``,
     ``input_std``, fixed buffers rather than learned) that a small network
@@ -103,7 +137,7 @@ class Standardiser:
         return (self,)
 
 
-Layer = Union[Dense, GMEdge, MultiAggregator, Scalar, Standardiser]
+Layer = Union[Dense, GMEdge, GMEdgeTrunk, MultiAggregator, Scalar, StandardisedMLP, Standardiser]
 
 
 @dataclass(frozen=True)
@@ -126,9 +160,8 @@ class NetworkSpec:
     label : str, the short name the panel shows (``"HeterSkinNet"``)
     description : str, one line: tooltips, ``--help`` and ``eval``'s method list
     inputs : str, what the forward reads (a class of the task's features)
-    layers : tuple of Dense, GMEdge, MultiAggregator, Scalar, Standardiser,
-        the parameters in the order training creates them (so a seeded run
-        starts from the same numbers)
+    layers : tuple of :data:`Layer`, the parameters in the order training
+        creates them (so a seeded run starts from the same numbers)
     forward : callable ``forward(ops, params, inputs)``, the network once
         for numpy and torch; its outputs are the task's (logits, scores)
     training : TrainingSettings

@@ -177,7 +177,7 @@ def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, re
 
     def held_loss(weights: dict) -> dict:
         params = {name: torch.as_tensor(value, device=record.device) for name, value in weights.items()}
-        return {"loss": float(connectivity_loss(spec, params, held_data, record.device))}
+        return {"held_out_loss": float(connectivity_loss(spec, params, held_data, record.device))}
 
     best = fit(module, lambda: [lambda: connectivity_loss(spec, module.params(), train_data, record.device)],
                held_loss, record=record, steps_per_epoch=1, log_every=FULL_BATCH_LOG_EVERY)
@@ -196,7 +196,7 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     """
     spec = rig_network(network)
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
-                       score_name="cd_j2j" if network == "joints" else "loss")
+                       score_name="cd_j2j" if network == "joints" else "held_out_loss")
     folder = Path(examples_dir or default_examples_dir(seed))
     examples = build_examples(training_samples(Path(sample_dir)), folder, seed)
     names = sorted(examples)

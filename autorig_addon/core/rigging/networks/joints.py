@@ -1,25 +1,25 @@
 """The joint network, after RigNet's joint stage (Xu et al. 2020).
 
-GMEdgeConv layers (EdgeConv over the mesh one-ring and over geodesic balls,
-fused, with a residual), a global max-pooled shape feature, and two heads
-per vertex: an *offset* that moves the vertex onto the joint it belongs to,
-and an *attention* logit that says how much its vote counts (vertices
-around a joint vote, those halfway along a limb do not). Its input is a
-:class:`..joint_features.JointGraph`; :mod:`..mean_shift` clusters the moved
-vertices into joints.
+RigNet's trunk (GMEdgeConv layers: EdgeConv over the mesh one-ring and over
+geodesic balls, fused, with a residual; a global max-pooled shape feature)
+and two heads per vertex: an *offset* that moves the vertex onto the joint
+it belongs to, and an *attention* logit that says how much its vote counts
+(vertices around a joint vote, those halfway along a limb do not). Its
+input is a :class:`..joint_features.JointGraph`; :mod:`..mean_shift`
+clusters the moved vertices into joints.
 """
 
 from __future__ import annotations
 
-from ...nn.convolution import gmedge_block
+from ...nn.convolution import gmedge_trunk
 from ...nn.layers import mlp
 from ...nn.operations import Array, Operations
-from ...nn.spec import Dense, GMEdge, NetworkSpec, TrainingSettings
+from ...nn.spec import Dense, GMEdgeTrunk, NetworkSpec, TrainingSettings
 from ..joint_features import VERTEX_FEATURES, JointGraph
 from .trained import TRAINED_FOLDER
 
 WIDTH = 64
-GMEDGE_LAYERS = ("gmedge1", "gmedge2", "gmedge3")
+TRUNK = GMEdgeTrunk(VERTEX_FEATURES, WIDTH, ("gmedge1", "gmedge2", "gmedge3"), 2 * WIDTH)
 
 
 def joint_network(ops: Operations, params: dict, graph: JointGraph) -> tuple[Array, Array]:
@@ -30,33 +30,20 @@ def joint_network(ops: Operations, params: dict, graph: JointGraph) -> tuple[Arr
     offsets : (n, 3) float array, normalised units
     attention_logits : (n,) float array (the attention is their sigmoid)
     """
-    activation = SPEC.activation
-    n = graph.vertex_features.shape[0]
-    x = mlp(ops, params, graph.vertex_features, "encoder.", activation=activation)
-    levels = [x]
-    for layer in GMEDGE_LAYERS:
-        x = gmedge_block(ops, params, x, graph.mesh_edges, graph.ball_edges, layer + ".", activation=activation)
-        levels.append(x)
-    shape = ops.column_max(mlp(ops, params, x, "shape.", activation=activation))
-    joined = ops.concat(levels + [ops.repeat_rows(shape, n)], 1)
-    offsets = mlp(ops, params, joined, "offset.", activation=activation, activate_last=False)
-    attention = mlp(ops, params, joined, "attention.", activation=activation, activate_last=False)
+    joined = gmedge_trunk(ops, params, graph.vertex_features, graph.mesh_edges, graph.ball_edges, TRUNK.blocks,
+                          activation=SPEC.activation)
+    offsets = mlp(ops, params, joined, "offset.", activation=SPEC.activation, activate_last=False)
+    attention = mlp(ops, params, joined, "attention.", activation=SPEC.activation, activate_last=False)
     return offsets, attention[:, 0]
 
 
-JOINED = (len(GMEDGE_LAYERS) + 1) * WIDTH + 2 * WIDTH
 SPEC = NetworkSpec(
     name="joints",
     label="Joints",
     description="Moves every vertex of the character onto its joint and weighs its vote (RigNet's joint stage)",
     inputs="JointGraph",
-    layers=(
-        Dense("encoder", (VERTEX_FEATURES, 2 * WIDTH, WIDTH)),
-        *(GMEdge(layer, WIDTH) for layer in GMEDGE_LAYERS),
-        Dense("shape", (WIDTH, 2 * WIDTH)),
-        Dense("offset", (JOINED, 2 * WIDTH, WIDTH, 3)),
-        Dense("attention", (JOINED, WIDTH, 1)),
-    ),
+    layers=(TRUNK, Dense("offset", (TRUNK.out_width, 2 * WIDTH, WIDTH, 3)),
+            Dense("attention", (TRUNK.out_width, WIDTH, 1))),
     forward=joint_network,
     # 80 epochs fitted the held-out characters better and the validation ones no better (docs/models.md).
     training=TrainingSettings(epochs=40, learning_rate=2e-3),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from ....nn.layers import mlp
 from ....nn.operations import Array, Operations
-from ....nn.spec import Dense, Scalar, TrainingSettings
+from ....nn.spec import Dense, TrainingSettings
 from ..features import BONE_FEATURES, PAIR_FEATURES, VERTEX_FEATURES, SkinGraph
 from .scoring import TRAINED_FOLDER, SkinNetworkSpec, candidate_pairs, scattered_scores
 
@@ -58,9 +58,7 @@ SPEC = SkinNetworkSpec(
     label="HeterSkinNet",
     description="HeterSkinNet (Pan et al. 2021) trained on artists' rigs: messages between vertices and bones "
                 "over HollowDist, for bones outside the body and loose parts",
-    inputs="SkinGraph",
     layers=(
-        Scalar("prior_scale", 1.0),
         Dense("vertex_encoder", (VERTEX_FEATURES, WIDTH, WIDTH)),
         Dense("bone_encoder", (BONE_FEATURES, WIDTH, WIDTH)),
         Dense("pair_encoder", (PAIR_FEATURES, WIDTH, WIDTH)),

@@ -1,40 +1,33 @@
 """RigNet's skinning network (Xu et al. 2020), sized for our data.
 
-The candidates' per-(vertex, bone) features concatenated per vertex,
-GMEdgeConv layers (EdgeConv over the mesh one-ring and over geodesic balls,
-fused), a global max-pooled shape feature, K scores per vertex. It reads a
-vertex's candidates side by side, so a skeleton of fewer deform bones than
-candidates leaves input slots it has never seen (no training character has
-fewer than 5 deform bones; a two-bone tube came out with its top on the
-wrong bone): it refuses such a skeleton.
+The candidates' per-(vertex, bone) features concatenated per vertex, RigNet's
+trunk (GMEdgeConv layers: EdgeConv over the mesh one-ring and over geodesic
+balls, fused; a global max-pooled shape feature), K scores per vertex. It
+reads a vertex's candidates side by side, so a skeleton of fewer deform
+bones than candidates leaves input slots it has never seen (no training
+character has fewer than 5 deform bones; a two-bone tube came out with its
+top on the wrong bone): it refuses such a skeleton.
 """
 
 from __future__ import annotations
 
-from ....nn.convolution import gmedge_block
+from ....nn.convolution import gmedge_trunk
 from ....nn.layers import mlp
 from ....nn.operations import Array, Operations
-from ....nn.spec import Dense, GMEdge, Scalar, TrainingSettings
+from ....nn.spec import Dense, GMEdgeTrunk, TrainingSettings
 from ..features import CANDIDATE_BONES, PAIR_FEATURES, VERTEX_FEATURES, SkinGraph
 from .scoring import TRAINED_FOLDER, SkinNetworkSpec
 
 WIDTH = 64
-GMEDGE_LAYERS = ("gmedge1", "gmedge2")
+TRUNK = GMEdgeTrunk(VERTEX_FEATURES + CANDIDATE_BONES * PAIR_FEATURES, WIDTH, ("gmedge1", "gmedge2"), WIDTH)
 
 
 def rignet_scores(ops: Operations, params: dict, graph: SkinGraph) -> Array:
     """(n, K) candidate scores."""
-    activation = SPEC.activation
     n = graph.vertex_features.shape[0]
     x = ops.concat([graph.vertex_features, graph.pair_features.reshape(n, -1)], 1)
-    x = mlp(ops, params, x, "encoder.", activation=activation)
-    levels = [x]
-    for layer in GMEDGE_LAYERS:
-        x = gmedge_block(ops, params, x, graph.mesh_edges, graph.ball_edges, layer + ".", activation=activation)
-        levels.append(x)
-    shape = ops.column_max(mlp(ops, params, x, "shape.", activation=activation))
-    joined = ops.concat(levels + [ops.repeat_rows(shape, n)], 1)
-    return mlp(ops, params, joined, "scores.", activation=activation, activate_last=False)
+    joined = gmedge_trunk(ops, params, x, graph.mesh_edges, graph.ball_edges, TRUNK.blocks, activation=SPEC.activation)
+    return mlp(ops, params, joined, "scores.", activation=SPEC.activation, activate_last=False)
 
 
 SPEC = SkinNetworkSpec(
@@ -42,14 +35,7 @@ SPEC = SkinNetworkSpec(
     label="RigNet",
     description="RigNet's network (Xu et al. 2020) trained on artists' rigs: graph convolutions over the mesh "
                 "and geodesic balls",
-    inputs="SkinGraph",
-    layers=(
-        Scalar("prior_scale", 1.0),
-        Dense("encoder", (VERTEX_FEATURES + CANDIDATE_BONES * PAIR_FEATURES, 2 * WIDTH, WIDTH)),
-        *(GMEdge(layer, WIDTH) for layer in GMEDGE_LAYERS),
-        Dense("shape", (WIDTH, WIDTH)),
-        Dense("scores", ((len(GMEDGE_LAYERS) + 2) * WIDTH, WIDTH, CANDIDATE_BONES), zero_last=True),
-    ),
+    layers=(TRUNK, Dense("scores", (TRUNK.out_width, WIDTH, CANDIDATE_BONES), zero_last=True)),
     forward=rignet_scores,
     # Still improving after 25 epochs.
     training=TrainingSettings(epochs=40, learning_rate=2e-3),

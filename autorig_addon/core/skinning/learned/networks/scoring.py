@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ....nn.operations import Array, Operations
-from ....nn.spec import NetworkSpec
+from ....nn.spec import NetworkSpec, Scalar
 from ..features import PRIOR_FLOOR, SkinGraph
 
 #: Folder of the shipped weights, one ``NAME.npz`` per network.
@@ -30,6 +30,8 @@ DISTANCE_KINDS = ("geodesic", "hollow")
 #: The priors a network may correct: our geometric method's weights, or
 #: bone heat as Blender computes it (:mod:`...heat_prior`).
 PRIOR_KINDS = ("geometric", "heat")
+#: The learned number the prior's logarithm is multiplied by.
+PRIOR_SCALE = "prior_scale"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -42,8 +44,13 @@ class SkinNetworkSpec(NetworkSpec):
     distance : one of :data:`DISTANCE_KINDS`, the distance through the shape it sees
     prior : one of :data:`PRIOR_KINDS`, the weights it corrects
     min_deform_bones : int, fewest deform bones it weights correctly
+
+    Every skinning network also learns the :data:`PRIOR_SCALE` its prior's
+    logarithm is multiplied by (:func:`candidate_weights`), created before
+    its layers.
     """
 
+    inputs: str = "SkinGraph"
     distance: str
     prior: str
     min_deform_bones: int = 1
@@ -52,11 +59,14 @@ class SkinNetworkSpec(NetworkSpec):
         if self.distance not in DISTANCE_KINDS or self.prior not in PRIOR_KINDS:
             raise ValueError(f"{self.name}: distance {self.distance!r} or prior {self.prior!r} unknown.")
 
+    def parts(self) -> tuple:
+        return (Scalar(PRIOR_SCALE, 1.0),) + super().parts()
+
 
 def candidate_weights(ops: Operations, params: dict, graph: SkinGraph, scores: Array) -> Array:
     """(n, K) weights: softmax over each vertex's valid candidates of the
     network ``scores`` plus ``prior_scale * log(prior)``."""
-    logits = scores + params["prior_scale"] * ops.log(graph.prior + PRIOR_FLOOR)
+    logits = scores + params[PRIOR_SCALE] * ops.log(graph.prior + PRIOR_FLOOR)
     return ops.masked_row_softmax(logits, graph.valid)
 
 

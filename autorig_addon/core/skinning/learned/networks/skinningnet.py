@@ -11,7 +11,7 @@ from __future__ import annotations
 from ....nn.convolution import multi_aggregator_convolution
 from ....nn.layers import mlp
 from ....nn.operations import Array, Operations
-from ....nn.spec import Dense, MultiAggregator, Scalar, TrainingSettings
+from ....nn.spec import Dense, MultiAggregator, TrainingSettings
 from ..features import BONE_FEATURES, PAIR_FEATURES, VERTEX_FEATURES, SkinGraph
 from .scoring import TRAINED_FOLDER, SkinNetworkSpec, candidate_pairs, scattered_scores
 
@@ -44,9 +44,7 @@ SPEC = SkinNetworkSpec(
     label="SkinningNet",
     description="SkinningNet (Mosella-Montoro and Ruiz-Hidalgo 2022) trained on artists' rigs: mesh and "
                 "skeleton streams of multi-aggregator graph convolutions",
-    inputs="SkinGraph",
     layers=(
-        Scalar("prior_scale", 1.0),
         Dense("vertex_encoder", (VERTEX_FEATURES, WIDTH, WIDTH)),
         *(MultiAggregator(layer, WIDTH, (WIDTH,)) for layer in MESH_LAYERS),
         Dense("bone_encoder", (BONE_FEATURES, WIDTH, WIDTH)),
