@@ -110,7 +110,7 @@ def main(argv=None) -> int:
     import bpy
 
     from autorig_addon.blender.convert import read_group_weights
-    from autorig_addon.blender.operators.transfer import TransferSettings, compute_transfer, plan_transfer
+    from autorig_addon.blender.jobs.transfer import TransferSettings, compute_transfer, plan_transfer
     from autorig_addon.blender.weight_writer import write_weights
     from autorig_addon.core.types import Weights
 

@@ -13,7 +13,7 @@ import pytest
 
 from autorig_addon import packaging
 from autorig_addon.blender import convert
-from autorig_addon.blender.operators.transfer import TransferSettings
+from autorig_addon.blender.jobs.transfer import TransferSettings
 from autorig_addon.cli import transfer as cli_transfer
 from autorig_addon.cli.batch import TextProgress, output_paths
 from autorig_addon.cli.main import SUBCOMMANDS, arguments_from_sys_argv, build_parser, main

@@ -309,7 +309,7 @@ def test_rignet_on_a_two_bone_armature_is_refused_and_the_scene_unchanged(clean_
 def test_an_unknown_method_from_python_is_refused_before_any_work(clean_scene):
     import bpy
 
-    from autorig_addon.blender.operators.skin import SkinSettings, plan_skin
+    from autorig_addon.blender.jobs.skin import SkinSettings, plan_skin
 
     armature, body = tube_scene()
     with pytest.raises(InputError, match=f"^{re.escape(UNKNOWN_METHOD)}$"):
@@ -319,7 +319,7 @@ def test_an_unknown_method_from_python_is_refused_before_any_work(clean_scene):
 def test_a_network_run_reports_progress_and_stops_on_esc(clean_scene):
     import bpy
 
-    from autorig_addon.blender.operators.skin import SkinSettings, _SkinJob, compute_skin, plan_skin
+    from autorig_addon.blender.jobs.skin import SkinJob, SkinSettings, compute_skin, plan_skin
     from blender_fixtures import scene_state
 
     armature, body = tube_scene()
@@ -332,7 +332,7 @@ def test_a_network_run_reports_progress_and_stops_on_esc(clean_scene):
     assert fractions == sorted(fractions) and 0.0 <= fractions[0] and reports[-1] == (1.0, "Weights done")
     assert "Running heterskinnet" in [message for _, message in reports]
     # Esc: the worker stops at the network's first progress report; nothing is written.
-    job = _SkinJob(plan, cancel=True)
+    job = SkinJob(plan, cancel=True)
     job.run()
     assert job.weights is None and isinstance(job.error, Cancelled) and str(job.error) == "Skinning cancelled."
     assert scene_state([armature, body]) == before

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import object_roles, status_attribute
-from autorig_addon.blender.operators import transfer as transfer_operators
-from autorig_addon.blender.operators.transfer import TransferSettings, run_transfer
+from autorig_addon.blender.jobs import transfer as transfer_job
+from autorig_addon.blender.jobs.transfer import TransferSettings, run_transfer
 from autorig_addon.blender.selection import unbound_meshes
 from autorig_addon.core.errors import InputError
 from blender_fixtures import (
@@ -315,7 +315,7 @@ def test_a_failed_write_shares_the_mesh_again_and_leaves_no_copy(clean_scene, mo
         if obj == upper:
             raise OSError("disk full")
 
-    monkeypatch.setattr(transfer_operators, "write_status_attribute", fail_on_second)
+    monkeypatch.setattr(transfer_job, "write_status_attribute", fail_on_second)
     with pytest.raises(RuntimeError, match="OSError: disk full"):
         bpy.ops.autorig.transfer_weights(source="Body", targets="Cuff.Lower,Cuff.Upper")
     assert lower.data == upper.data
@@ -324,7 +324,7 @@ def test_a_failed_write_shares_the_mesh_again_and_leaves_no_copy(clean_scene, mo
 
 
 def test_skinning_default_meshes_that_are_all_helpers_is_refused_naming_them(clean_scene):
-    from autorig_addon.blender.operators.skin import SkinSettings, plan_skin
+    from autorig_addon.blender.jobs.skin import SkinSettings, plan_skin
 
     rig = build_rig_scene(with_button=False)
     shape = bone_shape(rig.armature)

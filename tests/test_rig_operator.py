@@ -1,5 +1,6 @@
-"""Predict Skeleton and Auto-Rig (autorig_addon.blender.operators.rig) on a
-procedural biped, with real bpy."""
+"""Predict Skeleton and Auto-Rig (autorig_addon.blender.operators.rig and
+the job behind them, autorig_addon.blender.jobs.rig) on a procedural biped,
+with real bpy."""
 
 import re
 import time
@@ -10,9 +11,10 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import convert
-from autorig_addon.blender.operators import rig
-from autorig_addon.blender.operators.rig import PREDICTED_PROPERTY, RigSettings, plan_rig, rig_steps, run_steps
-from autorig_addon.blender.operators.skin import SkinSettings
+from autorig_addon.blender.jobs import rig
+from autorig_addon.blender.jobs.rig import PREDICTED_PROPERTY, RigSettings, plan_rig, rig_steps, run_steps
+from autorig_addon.blender.jobs.skin import SkinSettings
+from autorig_addon.blender.operators.rig import _RigOperator
 from autorig_addon.core.errors import Cancelled
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
@@ -221,12 +223,12 @@ class RigOperatorStandIn:
     """The modal machinery of the rig operators without Blender's operator
     object: reports recorded, a timer already added."""
 
-    modal = rig._RigOperator.modal
-    cancel = rig._RigOperator.cancel
-    _advance = rig._RigOperator._advance
-    _end_modal = rig._RigOperator._end_modal
-    _fail = rig._RigOperator._fail
-    _finish = rig._RigOperator._finish
+    modal = _RigOperator.modal
+    cancel = _RigOperator.cancel
+    _advance = _RigOperator._advance
+    _end_modal = _RigOperator._end_modal
+    _fail = _RigOperator._fail
+    _finish = _RigOperator._finish
 
     def __init__(self, steps):
         self._steps, self._job, self._timer = steps, None, "timer"

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pytest
 
-from autorig_addon.blender.operators import rignet
+from autorig_addon.blender.jobs import rignet
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.io.rignet_rig import read_rignet_rig
 from autorig_addon.core.types import Skeleton

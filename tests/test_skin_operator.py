@@ -6,8 +6,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from autorig_addon.blender.operators import skin
-from autorig_addon.blender.operators.skin import AUTORIG_OT_skin_weights, _SkinJob
+from autorig_addon.blender.jobs import skin
+from autorig_addon.blender.jobs.skin import SkinJob
+from autorig_addon.blender.operators.skin import AUTORIG_OT_skin_weights
 from autorig_addon.blender.progress import PROGRESS_STEPS
 from autorig_addon.core.errors import Cancelled
 from blender_fixtures import (
@@ -130,7 +131,7 @@ def test_zero_length_deform_bone_without_child_is_refused_by_name(clean_scene):
 def test_zero_length_bone_with_a_child_is_measured_to_the_child(clean_scene):
     import bpy
 
-    from autorig_addon.blender.operators.skin import SkinSettings, compute_skin, plan_skin
+    from autorig_addon.blender.jobs.skin import SkinSettings, compute_skin, plan_skin
 
     armature = make_armature()
     tube = unbound_cylinder()
@@ -239,18 +240,18 @@ def test_skin_job_reports_progress_and_stops_once_cancelled(monkeypatch):
         return "weights of " + plan
 
     monkeypatch.setattr(skin, "compute_skin", fake_compute)
-    job = _SkinJob("plan")
+    job = SkinJob("plan")
     job.run()
     assert (job.fraction, job.message, job.weights, job.error) == (0.5, "Voxelizing", "weights of plan", None)
 
-    cancelled = _SkinJob("plan", cancel=True)
+    cancelled = SkinJob("plan", cancel=True)
     cancelled.run()
     assert cancelled.weights is None and cancelled.fraction == 0.0
     assert isinstance(cancelled.error, Cancelled) and str(cancelled.error) == "Skinning cancelled."
 
 
 def test_cancel_removes_timer_progress_and_status_and_stops_the_worker():
-    job = _SkinJob("plan")
+    job = SkinJob("plan")
     operator, context = SkinOperatorStandIn(job), ui_context()
     operator.cancel(context)
     assert job.cancel  # the worker stops at its next progress report; its result is never read
@@ -262,7 +263,7 @@ def test_cancel_removes_timer_progress_and_status_and_stops_the_worker():
 
 
 def test_modal_shows_progress_then_ends_through_the_same_cleanup_on_esc():
-    job = _SkinJob("plan", fraction=0.25, message="Voxelizing")
+    job = SkinJob("plan", fraction=0.25, message="Voxelizing")
     operator, context = SkinOperatorStandIn(job), ui_context()
     assert operator.modal(context, SimpleNamespace(type="ESC")) == {"RUNNING_MODAL"}
     assert job.cancel and context.window_manager.calls == []

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.blender import convert, status_attribute
-from autorig_addon.blender.operators import transfer as transfer_operators
+from autorig_addon.blender.jobs import transfer as transfer_job
 from autorig_addon.blender.operators.transfer import scene_defaults
 from autorig_addon.blender.ui.properties import TRANSFER_OPTION_NAMES
 from autorig_addon.core.errors import Cancelled, InputError
@@ -220,7 +220,7 @@ def test_edit_mode_target_is_refused(rig):
     bpy.context.view_layer.objects.active = rig.body
     with pytest.raises(InputError, match=re.escape(
             "'Sleeve' is in Edit Mode: switch to Object Mode so its edits are saved, then transfer.")):
-        transfer_operators.plan_transfer(rig.body, [rig.sleeve], transfer_operators.TransferSettings(),
+        transfer_job.plan_transfer(rig.body, [rig.sleeve], transfer_job.TransferSettings(),
                                          bpy.context.evaluated_depsgraph_get())
     bpy.context.view_layer.objects.active = rig.sleeve
     assert scene_state([rig.body, rig.sleeve, rig.armature]) == before
@@ -232,7 +232,7 @@ def test_cancelling_changes_nothing(rig, monkeypatch, capfd):
     def cancelled(plan, depsgraph, progress=None):
         raise Cancelled()
 
-    monkeypatch.setattr(transfer_operators, "compute_transfer", cancelled)
+    monkeypatch.setattr(transfer_job, "compute_transfer", cancelled)
     before = scene_state([rig.body, rig.sleeve, rig.armature])
     capfd.readouterr()
     assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"CANCELLED"}
@@ -251,7 +251,7 @@ def test_a_failed_write_restores_every_target(rig, monkeypatch):
         if len(written) == 2:
             raise OSError("disk full")
 
-    monkeypatch.setattr(transfer_operators, "write_status_attribute", fail_on_second)
+    monkeypatch.setattr(transfer_job, "write_status_attribute", fail_on_second)
     objects = [rig.body, rig.sleeve, rig.armature, cuff]
     before = scene_state(objects)
     # Not an input error: a failure of the environment propagates, after the restore.

@@ -86,8 +86,8 @@ def clear_armatures(replace: bool) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..blender.operators.rig import RigSettings, plan_rig, rig_steps, run_steps
-    from ..blender.operators.skin import SkinSettings
+    from ..blender.jobs.rig import RigSettings, plan_rig, rig_steps, run_steps
+    from ..blender.jobs.skin import SkinSettings
 
     settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry)
     skin = None if args.skin == NO_SKIN else SkinSettings(method=args.skin)

@@ -62,7 +62,7 @@ def ignored_options_note(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..blender.operators.skin import SkinSettings, compute_skin, plan_skin, write_skin
+    from ..blender.jobs.skin import SkinSettings, compute_skin, plan_skin, write_skin
 
     # The options' destinations are named after the SkinSettings fields.
     settings = SkinSettings(**{field.name: getattr(args, field.name) for field in dataclasses.fields(SkinSettings)})

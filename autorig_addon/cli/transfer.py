@@ -79,7 +79,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def transfer_settings(args: argparse.Namespace):
     """The operator's ``TransferSettings`` from parsed arguments (whose
     destinations are named after the ``TransferOptions`` fields)."""
-    from ..blender.operators.transfer import TransferSettings
+    from ..blender.jobs.transfer import TransferSettings
     from ..blender.selection import split_names
 
     replace = args.replace or ("mix" if args.mix is not None else DEFAULT_REPLACE_CHOICE)
@@ -110,7 +110,7 @@ def transfer_file(args: argparse.Namespace, settings, input_path: Path, output_p
     import bpy
 
     from ..blender import scene_io
-    from ..blender.operators.transfer import run_transfer
+    from ..blender.jobs.transfer import run_transfer
     from ..blender.selection import find_object, names_in
 
     scene_io.load_scene(input_path)

@@ -1,367 +1,34 @@
-"""Predict Skeleton and Auto-Rig: an armature predicted from the selected
-meshes (``core.rigging.predict``), and the same bound with skin weights in
-one click.
-
-The work is written as a sequence of steps (:func:`rig_steps`): a generator
-that yields the slow, ``bpy``-free parts (the joint network, the skin
-weights) as tasks and does the Blender parts itself between them. The modal
-operators run each task in a worker thread (progress in the status bar, Esc
-cancels); background runs and the ``rig`` command run the same steps on the
-main thread (:func:`run_steps`). A failure or a cancel anywhere removes the
-armature and restores every mesh, so nothing is ever left half built.
-
-Live level of detail: the network outputs of each prediction stay in memory
-(:data:`_PREDICTIONS`, keyed by a token stored on the armature as the custom
-property :data:`PREDICTED_PROPERTY`). While that armature is what the
-prediction built (its rest bones unchanged, not in Edit Mode, no mesh bound
-to it), changing the Rig panel's *Bandwidth*, *Density Threshold* or
-*Symmetry* re-clusters the cached votes and rebuilds its bones in place
-(:func:`update_live_prediction`, a fraction of a second); once the artist
-edits it, the settings wait for the next *Predict Skeleton*.
+"""The Predict Skeleton and Auto-Rig operators: the selected meshes
+(:mod:`..selection`), the options from their properties, the steps of
+:mod:`..jobs.rig` run by a worker thread (progress in the status bar, Esc
+cancels) or, in background mode, on the main thread.
 """
 
 from __future__ import annotations
 
-import uuid
-from collections import OrderedDict
-from dataclasses import dataclass
-from typing import Callable, Generator
-
 import bpy
-import numpy as np
 from bpy.props import BoolProperty
 
 from ...core.errors import Cancelled, InputError
-from ...core.geometry.outliers import require_finite_positions
-from ...core.progress import ProgressCallback, sub_progress
-from ...core.rigging.predict import JointVotes, predict_votes, skeleton_from_votes
-from ...core.skeleton.checks import skeleton_extent
-from ...core.skinning.methods import SKIN_METHOD_LABELS
-from ...core.types import Mesh, Skeleton
-from .. import convert
-from ..armature_binding import bound_armature, remove_armature, unbind
-from ..armature_builder import build_armature
+from ..jobs.input_checks import mode_poll
+from ..jobs.rig import RigPlan, RigResult, TaskJob, plan_rig, rig_steps, run_steps
+from ..jobs.skin import SkinSettings
 from ..progress import blender_progress
 from ..selection import character_name, selected_meshes
-from ..snapshot import restored_on_failure
 from ..ui.properties import (
-    REPLACE_BINDING_DESCRIPTION, RIG_OPTION_NAMES, SKIN_OPTION_NAMES, RigOptionProperties, SkinOptionProperties,
+    REPLACE_BINDING_DESCRIPTION,
+    RIG_OPTION_NAMES,
+    SKIN_OPTION_NAMES,
+    RigOptionProperties,
+    SkinOptionProperties,
+    rig_settings_from,
+    scene_values,
+    skin_settings_from,
 )
-from ..jobs.input_checks import check_mode, mode_poll
-from .modal_job import ModalJobOperator, WorkerJob, show_job_event
-from .skin import SkinSettings, compute_skin, plan_skin, skin_settings_from, write_skin
+from .modal_job import ModalJobOperator, show_job_event
 
-#: Custom property marking an armature built by a prediction; its value is
-#: the key of the prediction's cached network outputs.
-PREDICTED_PROPERTY = "autorig_predicted"
-#: Predictions whose network outputs stay in memory for live re-clustering;
-#: past this many the oldest is forgotten (its armature then keeps its bones).
-MAX_CACHED_PREDICTIONS = 8
-#: The armature is named after the character: its name plus this suffix.
-ARMATURE_SUFFIX = "_rig"
-#: Share of the progress bar the skeleton takes in Auto-Rig; the skin weights take the rest.
-PREDICTION_SHARE = 0.4
-#: Rest bone positions differing by more than this share of the skeleton's
-#: extent mean the armature was edited (Blender stores bones in float32).
-EDIT_TOLERANCE = 1e-5
 #: Prefix of the status-bar text while a prediction runs.
 RIG_PROGRESS_TITLE = "Auto-Rig"
-
-
-@dataclass(frozen=True)
-class RigSettings:
-    """Options of the clustering (``core.rigging.predict.skeleton_from_votes``),
-    the core's defaults unless given.
-
-    Attributes
-    ----------
-    bandwidth : float or None, mean-shift bandwidth as a share of the character's largest side
-    density_threshold : float or None, share of the strongest mode's vote mass below which a mode is dropped
-    symmetry : bool or None, mirror votes and pair joints when the shape is left-right symmetric
-    """
-
-    bandwidth: float | None = None
-    density_threshold: float | None = None
-    symmetry: bool | None = None
-
-    def keywords(self) -> dict:
-        """The keyword arguments of ``skeleton_from_votes`` that were given."""
-        return {name: value for name, value in vars(self).items() if value is not None}
-
-
-@dataclass
-class RigPlan:
-    """Checked inputs of a prediction.
-
-    Attributes
-    ----------
-    meshes : list of bpy.types.Object, the character's meshes
-    mesh : Mesh, their world-space rest shape, concatenated
-    name : str, the name of the armature to build
-    settings : RigSettings
-    skin : SkinSettings or None, bind the meshes with these (Auto-Rig) or not
-    replace : bool, unbind meshes already bound to an armature before binding them
-    named : bool, the user picked the meshes (False: every mesh of a file; see ``plan_skin``)
-    """
-
-    meshes: list
-    mesh: Mesh
-    name: str
-    settings: RigSettings = RigSettings()
-    skin: SkinSettings | None = None
-    replace: bool = False
-    named: bool = True
-
-
-@dataclass
-class RigResult:
-    """What a run built: the armature, its skeleton, the notes of the
-    prediction and, when it bound the meshes, the skin plan and weights."""
-
-    armature: object
-    skeleton: Skeleton
-    notes: tuple = ()
-    skin_plan: object = None
-    weights: object = None
-
-
-@dataclass
-class _Prediction:
-    """A cached prediction: the network outputs and the skeleton the
-    armature had when last built from them (world space, as read back)."""
-
-    votes: JointVotes
-    built: Skeleton
-
-
-_PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
-
-
-def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
-             skin: SkinSettings | None = None, replace: bool = False, named: bool = True) -> RigPlan:
-    """Read and check the character's meshes; raises :class:`InputError` on bad input.
-
-    Parameters
-    ----------
-    meshes : list of bpy.types.Object, one character
-    depsgraph : bpy.types.Depsgraph (the meshes are read evaluated, armatures at rest)
-    name : str, the character's name (the armature is called ``name + ARMATURE_SUFFIX``)
-    settings : RigSettings
-    skin : SkinSettings or None; given, the meshes are bound, and a mesh
-        already bound to an armature is refused unless ``replace``
-    replace : bool
-    named : bool, see :class:`RigPlan`
-    """
-    meshes = list(dict.fromkeys(meshes))
-    if not meshes:
-        raise InputError("Select the mesh(es) of the character to rig.")
-    for obj in meshes:
-        convert.require_mesh_object(obj, "mesh to rig")
-        check_mode(obj, "rig")
-    if skin is not None and not replace:
-        bound = [(obj, bound_armature(obj)) for obj in meshes if bound_armature(obj) is not None]
-        if bound:
-            obj, armature = bound[0]
-            raise InputError(
-                f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
-                "it to the new skeleton instead, or remove its Armature modifier first."
-            )
-    mesh = convert.read_mesh(meshes, depsgraph)
-    require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named)
-
-
-def _remember(armature, votes: JointVotes) -> None:
-    """Cache ``votes`` for live re-clustering of ``armature`` (marked with a new token)."""
-    token = uuid.uuid4().hex
-    armature[PREDICTED_PROPERTY] = token
-    _PREDICTIONS[token] = _Prediction(votes, convert.read_skeleton(armature))
-    while len(_PREDICTIONS) > MAX_CACHED_PREDICTIONS:
-        _PREDICTIONS.popitem(last=False)
-
-
-Task = Callable[[ProgressCallback | None], object]
-
-
-def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Task, object, RigResult]:
-    """The steps of a prediction (and, with ``plan.skin``, the binding).
-    ``remember``: cache the votes for live re-clustering (the operators; not
-    the command line, whose session ends).
-
-    Yields the ``bpy``-free tasks, ``task(progress) -> result``, and
-    receives their results; does the Blender work itself in between. Drive
-    it with :func:`run_steps` or the modal operators. Whatever raises
-    (including :class:`Cancelled` thrown in at a yield, or the generator
-    being closed), the armature is removed and the meshes restored.
-    """
-    share = PREDICTION_SHARE if plan.skin is not None else 1.0
-    votes = yield lambda progress: predict_votes(plan.mesh, sub_progress(progress, 0.0, share))
-    skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
-    armature = build_armature(skeleton, plan.name, context)
-    try:
-        armature.show_in_front = True  # the bones are inside the body
-        result = RigResult(armature, skeleton, votes.notes)
-        if plan.skin is not None:
-            with restored_on_failure(plan.meshes):
-                if plan.replace:
-                    for obj in plan.meshes:
-                        unbind(obj)
-                skin_plan = plan_skin(armature, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
-                                      named=plan.named)
-                weights = yield lambda progress: compute_skin(skin_plan, sub_progress(progress, share, 1.0))
-                write_skin(skin_plan, weights)
-            result.skin_plan, result.weights = skin_plan, weights
-        if remember:
-            _remember(armature, votes)
-    except BaseException:
-        remove_armature(armature)
-        raise
-    return result
-
-
-def run_steps(steps: Generator, progress: ProgressCallback | None = None):
-    """Run ``steps`` (:func:`rig_steps`) on this thread; returns its result.
-    A task's exception is thrown into the steps, so they clean up."""
-    try:
-        task = steps.send(None)
-        while True:
-            try:
-                result = task(progress)
-            except BaseException as error:  # the steps clean up and re-raise
-                task = steps.throw(error)
-            else:
-                task = steps.send(result)
-    except StopIteration as stop:
-        return stop.value
-
-
-# --------------------------------------------------------------------------- live re-clustering
-
-
-def _prediction_of(obj) -> _Prediction | None:
-    if obj is None or obj.type != "ARMATURE":
-        return None
-    return _PREDICTIONS.get(obj.get(PREDICTED_PROPERTY, ""))
-
-
-def live_armature(context) -> tuple[object, str]:
-    """The predicted armature the Rig settings update, and what the panel
-    says about it.
-
-    The active object if it is a predicted armature, else the most recently
-    predicted one in the scene. Returns ``(armature, "")`` when it can be
-    updated, ``(None, note)`` when it cannot (edited, in Edit Mode, bound),
-    ``(None, "")`` when there is none.
-    """
-    scene_objects = set(context.scene.objects)
-    candidates = [obj for obj in scene_objects if _prediction_of(obj) is not None]
-    if not candidates:
-        return None, ""
-    active = context.active_object
-    if active in candidates:
-        armature = active
-    else:
-        order = list(_PREDICTIONS)
-        armature = max(candidates, key=lambda obj: order.index(obj[PREDICTED_PROPERTY]))
-    if armature.mode == "EDIT":
-        return None, f"'{armature.name}' is in Edit Mode: the settings wait for the next Predict Skeleton"
-    if not _unedited(armature, _prediction_of(armature).built):
-        return None, f"'{armature.name}' was edited: the settings apply at the next Predict Skeleton"
-    bound = [obj.name for obj in context.scene.objects if obj.type == "MESH" and bound_armature(obj) == armature]
-    if bound:
-        return None, f"'{armature.name}' is bound to meshes: the settings apply at the next Predict Skeleton"
-    return armature, ""
-
-
-def _unedited(armature, built: Skeleton) -> bool:
-    """Whether ``armature`` still holds the bones it was built with (names,
-    parents, deform flags, world-space heads and tails within
-    :data:`EDIT_TOLERANCE` of the extent)."""
-    try:
-        now = convert.read_skeleton(armature)
-    except InputError:  # every bone deleted
-        return False
-    if now.names != built.names or not np.array_equal(now.parents, built.parents) \
-            or not np.array_equal(now.deform, built.deform):
-        return False
-    tolerance = EDIT_TOLERANCE * max(skeleton_extent(built), 1e-9)
-    return bool(np.abs(now.joints - built.joints).max() <= tolerance
-                and np.abs(now.tails - built.tails).max() <= tolerance)
-
-
-def rebuild_armature(armature, skeleton: Skeleton, context) -> None:
-    """Replace the bones of ``armature`` with ``skeleton`` (world space; the
-    object, its name and its transform stay): a new armature datablock
-    built whole by ``build_armature`` takes the old one's place."""
-    fresh = build_armature(skeleton, armature.data.name, context)
-    old, name = armature.data, armature.data.name
-    armature.data = fresh.data
-    bpy.data.objects.remove(fresh)
-    bpy.data.armatures.remove(old)
-    armature.data.name = name
-
-
-def update_live_prediction(context, settings: RigSettings) -> object:
-    """Re-cluster the live predicted armature (:func:`live_armature`) with
-    ``settings``; returns it, or None when there is none to update.
-    Raises :class:`InputError` when the new skeleton cannot be built (the
-    armature is unchanged then)."""
-    armature, _ = live_armature(context)
-    if armature is None:
-        return None
-    prediction = _prediction_of(armature)
-    skeleton = skeleton_from_votes(prediction.votes, **settings.keywords())
-    rebuild_armature(armature, skeleton, context)
-    prediction.built = convert.read_skeleton(armature)
-    _PREDICTIONS.move_to_end(armature[PREDICTED_PROPERTY])
-    return armature
-
-
-#: Why the last live update left the armature as it was ("" when it succeeded), for the panel.
-_LIVE_FAILURE = {"message": ""}
-
-
-def on_rig_setting_changed(settings, context) -> None:
-    """Update callback of the scene's Rig settings: re-cluster the live
-    armature. A skeleton that cannot be built (no joint at that density)
-    leaves the armature unchanged; the panel shows why (:func:`live_note`)."""
-    try:
-        update_live_prediction(context, rig_settings_from(settings))
-    except InputError as error:
-        _LIVE_FAILURE["message"] = str(error)
-    else:
-        _LIVE_FAILURE["message"] = ""
-
-
-def live_note(context) -> tuple[str, str]:
-    """What the Rig panel says about live updates: ``(text, icon)``; the
-    text is "" when there is no predicted armature."""
-    armature, note = live_armature(context)
-    if armature is None:
-        return note, "INFO"
-    if _LIVE_FAILURE["message"]:
-        return _LIVE_FAILURE["message"], "ERROR"
-    return f"Live: the settings update '{armature.name}'", "ARMATURE_DATA"
-
-
-def rig_settings_from(props) -> RigSettings:
-    """RigSettings from the ``rig_*`` properties of an operator or the scene settings."""
-    return RigSettings(**{name[len("rig_"):]: getattr(props, name) for name in RIG_OPTION_NAMES})
-
-
-# --------------------------------------------------------------------------- operators
-
-
-@dataclass
-class _TaskJob(WorkerJob):
-    """One task of the steps, run by a worker thread for a modal operator;
-    its outcome is handed to the steps on the main thread."""
-
-    task: Task
-    cancelled_message = "Rigging cancelled."
-
-    def compute(self, progress: ProgressCallback):
-        return self.task(progress)
 
 
 class _RigOperator(ModalJobOperator, RigOptionProperties):
@@ -391,10 +58,8 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
                         skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)))
 
     def invoke(self, context, event):
-        settings = context.scene.autorig
-        for name in self.option_names():
-            if not self.properties.is_property_set(name):
-                setattr(self, name, getattr(settings, name))
+        for name, value in scene_values(context, self.option_names(), self.properties.is_property_set).items():
+            setattr(self, name, value)
         if bpy.app.background or context.window_manager is None or not context.window_manager.windows:
             return self.execute(context)
         try:
@@ -424,7 +89,7 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
             self._end_modal(context)
             self.report({"ERROR"}, f"Rigging failed: {failure!r}")
             return {"CANCELLED"}
-        self._job = _TaskJob(task).start()
+        self._job = TaskJob(task).start()
         return None
 
     def modal(self, context, event):
@@ -457,8 +122,7 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
         text = f"Predicted '{armature.name}' with {len(armature.data.bones)} bones"
         if result.skin_plan is not None:
             plan = result.skin_plan
-            text += (f", {len(plan.meshes)} mesh(es) skinned with {SKIN_METHOD_LABELS[plan.settings.method]}"
-                     f"{plan.summary}")
+            text += f", {len(plan.meshes)} mesh(es) skinned with {plan.settings.method_label}{plan.summary}"
         notes = "".join(f"; {note}" for note in result.notes)
         self.report({"INFO"}, f"{text}{notes}.")
         return {"FINISHED"}

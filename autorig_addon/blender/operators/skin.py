@@ -1,255 +1,27 @@
-"""Skin weights for meshes and any armature, by the geometric method or a
-trained network (``core.skinning.methods``).
+"""The Skin Weights operator: the armature and meshes from its names or the
+selection (:mod:`..selection`), the options from its properties, the work
+done by :mod:`..jobs.skin`.
 
-As with transfer, nothing is written before everything is computed:
-
-1. :func:`plan_skin` checks the armature and meshes and reads them once,
-2. :func:`compute_skin` runs the core method (no ``bpy``: safe in a thread),
-3. :func:`write_skin` writes every mesh, restoring all of them if any
-   write fails.
-
-What the plan does with props parented to a bone, helper objects, linked
-duplicates and stray vertices: :mod:`..object_roles` and
-:mod:`autorig_addon.core.geometry.outliers`; each is named in the report.
-
-From the UI the operator runs step 2 in a worker thread so Blender stays
-responsive, shows progress and stops on Esc; in background mode (scripts,
-the command line) it runs synchronously.
+From the UI the computation runs in a worker thread so Blender stays
+responsive, shows progress and stops on Esc; in background mode (scripts)
+it runs synchronously.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import bpy
-import numpy as np
 from bpy.props import StringProperty
 
-from ...core.skinning import geometric as skinning
-from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_LABELS, check_skin_method, skin_weights
 from ...core.errors import Cancelled, InputError
-from ...core.progress import ProgressCallback
-from ...core.messages import listed_names
-from ...core.skeleton.tails import TailDecision, with_reliable_tails
-from ...core.types import Mesh, Skeleton, Weights
-from ...core.distances.grid import DEFAULT_RESOLUTION
-from ...core.geometry.outliers import require_finite_positions, rows_for_strays
-from .. import convert
-from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
+from ..jobs.input_checks import mode_poll
+from ..jobs.skin import SkinJob, SkinPlan, plan_skin, run_skin, skin_report, write_skin
 from ..progress import blender_progress
 from ..selection import resolve_skin_inputs
-from ..snapshot import restored_on_failure
-from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties
-from ..weight_writer import bind_to_bone, write_weights
-from ..jobs.input_checks import check_mode, mode_poll, split_strays, stray_notes
-from .modal_job import ModalJobOperator, WorkerJob, show_job_event
+from ..ui.properties import SKIN_OPTION_NAMES, SkinOptionProperties, scene_values, skin_settings_from
+from .modal_job import ModalJobOperator, show_job_event
 
-#: When even the deform bone point nearest the mesh's bounding box is
-#: farther than this many mesh diagonals from it, the armature was not
-#: placed on the character.
-MAX_ARMATURE_OFFSET = 0.5
 #: Prefix of the status-bar text while skinning runs.
 SKIN_PROGRESS_TITLE = "Skin weights"
-
-
-@dataclass(frozen=True)
-class SkinSettings:
-    """Options of a skinning run: the method and the keyword arguments of
-    ``core.skinning.methods.skin_weights`` with the core's defaults, plus
-    how the result is written.
-
-    Attributes
-    ----------
-    method : one of ``core.skinning.methods.SKIN_METHODS``
-    distance : "geodesic" (volumetric geodesic, RigNet) or "hollow" (HollowDist, HeterSkinNet); geometric method only
-    resolution : int, voxels along the longest side
-    falloff : float, heat strength (higher: sharper blends); geometric method only
-    max_influences : int, bones per vertex (0 = no limit)
-    smoothing_iterations : int; geometric method only
-    smoothing_strength : float in [0, 1]; geometric method only
-    replace_all : bool, remove every existing vertex group first
-    """
-
-    method: str = DEFAULT_SKIN_METHOD
-    distance: str = skinning.DEFAULT_DISTANCE
-    resolution: int = DEFAULT_RESOLUTION
-    falloff: float = skinning.DEFAULT_FALLOFF
-    max_influences: int = skinning.DEFAULT_MAX_INFLUENCES
-    smoothing_iterations: int = skinning.DEFAULT_SMOOTHING_ITERATIONS
-    smoothing_strength: float = skinning.DEFAULT_SMOOTHING_STRENGTH
-    replace_all: bool = False
-
-
-@dataclass
-class SkinPlan:
-    """Checked inputs: the armature, the meshes and their arrays.
-
-    ``skeleton`` holds the tails distances are measured along: the
-    armature's own, or tails derived from the joints where its bones are
-    point-like (``core.skeleton.tails.with_reliable_tails``; the armature
-    itself is never changed). ``tail_decision`` says which and why.
-
-    Attributes
-    ----------
-    armature : bpy.types.Object
-    meshes : list of bpy.types.Object, the meshes skinned together
-    mesh : Mesh of ``meshes`` (None when there are none)
-    skeleton : Skeleton
-    settings : SkinSettings
-    tail_decision : TailDecision
-    strays : (n,) bool array over ``mesh``'s vertices, far strays left out of
-        the computation and weighted like their nearest kept vertex
-        (``core.geometry.outliers``), or None
-    solved : Mesh the weights are computed on: ``mesh`` without ``strays``
-    rigid : list of RigidBinding, props bound wholly to the bone they were parented to
-    notes : list of str, what the report adds about them, linked duplicates and props left rigid
-    """
-
-    armature: object
-    meshes: list
-    mesh: Mesh | None
-    skeleton: Skeleton
-    settings: SkinSettings
-    tail_decision: TailDecision = TailDecision()
-    strays: np.ndarray | None = None
-    solved: Mesh | None = None
-    rigid: list = field(default_factory=list)
-    notes: list = field(default_factory=list)
-
-    @property
-    def summary(self) -> str:
-        """What the report adds to "Skinned ...": the derived tails, if any, and the notes."""
-        text = f" ({self.tail_decision.note})" if self.tail_decision.any_derived else ""
-        return text + "".join(f"; {note}" for note in self.notes)
-
-
-def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str) -> None:
-    size = mesh.bounding_box_diagonal
-    lo, hi = mesh.vertices.min(0), mesh.vertices.max(0)
-    points = np.vstack([skeleton.joints, skeleton.tails])
-    outside = np.maximum(lo - points, 0) + np.maximum(points - hi, 0)
-    if np.linalg.norm(outside, axis=1).min() > MAX_ARMATURE_OFFSET * size:
-        raise InputError(
-            f"The armature '{armature_name}' lies far from the mesh: move it onto the character "
-            "(or apply the object transforms) before skinning."
-        )
-
-
-def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True) -> SkinPlan:
-    """Read and check the inputs; raises :class:`InputError` on bad input.
-
-    Parameters
-    ----------
-    armature : bpy.types.Object
-    meshes : list of bpy.types.Object
-    settings : SkinSettings
-    depsgraph : bpy.types.Depsgraph
-    named : bool
-        True when the user named or selected ``meshes``; False when the run
-        picked them itself (every mesh of a file): helper objects are then
-        left out and props on a bone left rigid.
-    """
-    check_skin_method(settings.method)
-    convert.require_armature_object(armature)
-    meshes = list(dict.fromkeys(meshes))
-    found = meshes
-    if not named:
-        meshes = without_helpers(meshes)
-    if not meshes and found:
-        raise InputError(
-            f"Nothing to skin: the meshes found ({listed_names([obj.name for obj in found], quoted=True)}) are helpers "
-            "(bone shapes, hidden from render). Name the meshes to skin them: --mesh on the command line, "
-            "meshes= from Python."
-        )
-    if not meshes:
-        raise InputError("Select the mesh(es) to skin together with the armature.")
-    check_mode(armature, "skin")
-    for obj in meshes:
-        convert.require_mesh_object(obj, "mesh to skin")
-        check_mode(obj, "skin")
-    skeleton = convert.read_skeleton(armature)
-    if not skeleton.deform.any():
-        raise InputError(f"The armature '{armature.name}' has no deform bones: enable Deform on the bones to weight.")
-    meshes, rigid, left_rigid = split_bone_parented(meshes, armature, named)
-    # Named props left rigid sit on a bone that does not deform.
-    notes = [f"'{obj.name}' {left_rigid_note(obj)}" + (" (it does not deform)" if named else "") for obj in left_rigid]
-    notes += [f"'{binding.obj.name}' {binding.note}" for binding in rigid]
-    if not meshes and not rigid:
-        raise InputError(f"Nothing to skin: {'; '.join(notes)}.")
-    notes += [f"'{obj.name}' {note}" for obj, note in shared_mesh_notes(meshes + [b.obj for b in rigid]).items()]
-    if not meshes:
-        return SkinPlan(armature, [], None, skeleton, settings, rigid=rigid, notes=notes)
-    mesh = convert.read_mesh(meshes, depsgraph)
-    require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-    solved, strays = split_strays(mesh)
-    if solved.bounding_box_diagonal <= 0:
-        raise InputError("The mesh has zero size.")
-    if strays is not None:
-        notes += [f"'{name}': {note}" for name, note in stray_notes(mesh, strays, "the distances").items()]
-    # Point-like bones (glTF imports of scaled armatures) get tails derived
-    # from the joints; a zero-length deform bone with no child is refused.
-    skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)
-    _check_skeleton_fits_mesh(skeleton.deform_subset(), solved, armature.name)
-    return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes)
-
-
-def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> Weights:
-    """(n, deform bones) weights for every vertex of every mesh; no ``bpy``.
-    Far strays are left out of the computation and take the weights of the
-    nearest kept vertex (``core.geometry.outliers.rows_for_strays``)."""
-    s = plan.settings
-    if plan.mesh is None:
-        names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
-        return Weights(np.zeros((0, len(names))), names)
-    weights = skin_weights(
-        plan.solved, plan.skeleton, s.method, max_influences=int(s.max_influences), resolution=int(s.resolution),
-        progress=progress, distance=s.distance, falloff=float(s.falloff),
-        smoothing_iterations=int(s.smoothing_iterations), smoothing_strength=float(s.smoothing_strength),
-    )
-    if plan.strays is None:
-        return weights
-    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, plan.strays)
-    return Weights(rows, weights.bone_names)
-
-
-def write_skin(plan: SkinPlan, weights: Weights) -> None:
-    """Write each mesh's rows and bind the props on a bone to it; on any
-    failure every object is restored. Linked duplicates get their own mesh
-    first."""
-    with restored_on_failure(plan.meshes + [binding.obj for binding in plan.rigid]):
-        for index, obj in enumerate(plan.meshes):
-            give_own_mesh(obj)
-            rows = plan.mesh.object_slice(index)
-            write_weights(obj, Weights(weights.matrix[rows], weights.bone_names), plan.armature,
-                          replace_all=plan.settings.replace_all)
-        for binding in plan.rigid:
-            give_own_mesh(binding.obj)
-            bind_to_bone(binding.obj, binding.armature, binding.bone, binding.rest_world)
-
-
-def skin_settings_from(props) -> SkinSettings:
-    """SkinSettings from the ``skin_*`` properties of the operator or scene settings."""
-    values = {name[len("skin_"):]: getattr(props, name) for name in SKIN_OPTION_NAMES}
-    values["distance"] = values["distance"].lower()
-    values["method"] = values["method"].lower()
-    return SkinSettings(**values)
-
-
-@dataclass
-class _SkinJob(WorkerJob):
-    """A skinning computation (:func:`compute_skin` of ``plan``) run by a
-    worker thread for the modal operator; the weights are ``weights``."""
-
-    plan: SkinPlan
-    cancelled_message = "Skinning cancelled."
-
-    def compute(self, progress: ProgressCallback) -> Weights:
-        return compute_skin(self.plan, progress)
-
-    @property
-    def weights(self) -> Weights | None:
-        """The computed weights (None until the worker finishes, or when it failed)."""
-        return self.result
 
 
 class AUTORIG_OT_skin_weights(ModalJobOperator, SkinOptionProperties, bpy.types.Operator):
@@ -269,10 +41,8 @@ class AUTORIG_OT_skin_weights(ModalJobOperator, SkinOptionProperties, bpy.types.
         return mode_poll(cls, context, cls.bl_label)
 
     def invoke(self, context, event):
-        settings = context.scene.autorig
-        for name in SKIN_OPTION_NAMES:
-            if not self.properties.is_property_set(name):
-                setattr(self, name, getattr(settings, name))
+        for name, value in scene_values(context, SKIN_OPTION_NAMES, self.properties.is_property_set).items():
+            setattr(self, name, value)
         if bpy.app.background or context.window_manager is None or not context.window_manager.windows:
             return self.execute(context)
         try:
@@ -281,7 +51,7 @@ class AUTORIG_OT_skin_weights(ModalJobOperator, SkinOptionProperties, bpy.types.
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self._job = _SkinJob(plan).start()
+        self._job = SkinJob(plan).start()
         self._thread = self._job.thread
         self._begin_modal(context)
         return {"RUNNING_MODAL"}
@@ -308,26 +78,26 @@ class AUTORIG_OT_skin_weights(ModalJobOperator, SkinOptionProperties, bpy.types.
             self._job.cancel = True
         self._end_modal(context)
 
-    def _write(self, plan: SkinPlan, weights: Weights):
+    def _write(self, plan: SkinPlan, weights):
         try:
             write_skin(plan, weights)
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Skinned {len(plan.meshes)} mesh(es) to {weights.matrix.shape[1]} deform bones of "
-                              f"'{plan.armature.name}' with {SKIN_METHOD_LABELS[plan.settings.method]}{plan.summary}.")
+        self.report({"INFO"}, skin_report(plan, weights))
         return {"FINISHED"}
 
     def execute(self, context):
         try:
             armature, meshes = resolve_skin_inputs(context, self.armature, self.meshes)
-            plan = plan_skin(armature, meshes, skin_settings_from(self), context.evaluated_depsgraph_get())
             with blender_progress(context, SKIN_PROGRESS_TITLE) as progress:
-                weights = compute_skin(plan, progress)
+                plan, weights = run_skin(armature, meshes, skin_settings_from(self), context.evaluated_depsgraph_get(),
+                                         progress)
         except (InputError, Cancelled) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        return self._write(plan, weights)
+        self.report({"INFO"}, skin_report(plan, weights))
+        return {"FINISHED"}
 
 
 classes = (AUTORIG_OT_skin_weights,)

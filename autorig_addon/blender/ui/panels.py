@@ -3,7 +3,8 @@
 import bpy
 
 from ...core.skinning.methods import GEOMETRIC
-from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton, live_note
+from ..jobs.rig import live_note
+from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton
 from ..operators.skin import AUTORIG_OT_skin_weights
 from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
 from ..selection import selected_meshes, selected_targets

@@ -25,6 +25,8 @@ from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_DESCRIPTIO
 from ...core.transfer import combine
 from ...core.transfer import options as transfer_options
 from ...core.weights import MAX_INFLUENCES
+from ..jobs.rig import RigSettings, on_rig_setting_changed
+from ..jobs.skin import SkinSettings
 
 #: Default absolute match distance, metres, used only when "Absolute Distance" is on.
 DEFAULT_MAX_DISTANCE = 0.05
@@ -225,12 +227,10 @@ SKIN_OPTION_NAMES = tuple(SkinOptionProperties.__annotations__)
 
 def _update_live_prediction(self, context) -> None:
     """A Rig setting of the scene changed: re-cluster the predicted armature
-    while it is unedited (``operators.rig``); an operator's own copy of the
+    while it is unedited (``jobs.rig``); an operator's own copy of the
     option (no scene behind it) changes nothing."""
     if isinstance(getattr(self, "id_data", None), bpy.types.Scene):
-        from ..operators.rig import on_rig_setting_changed
-
-        on_rig_setting_changed(self, context)
+        on_rig_setting_changed(context, rig_settings_from(self))
 
 
 class RigOptionProperties:
@@ -290,6 +290,29 @@ class AutoRigSceneSettings(TransferOptionProperties, SkinOptionProperties, RigOp
         type=bpy.types.Object,
         poll=_is_mesh,
     )
+
+
+def scene_values(context, names, is_set) -> dict:
+    """{name: value} of the scene settings' properties ``names`` that the
+    caller has not set itself (``is_set(name)`` False): what a panel button
+    hands its operator. Empty when the scene has no settings."""
+    settings = getattr(context.scene, "autorig", None)
+    if settings is None:
+        return {}
+    return {name: getattr(settings, name) for name in names if not is_set(name)}
+
+
+def skin_settings_from(props) -> SkinSettings:
+    """SkinSettings from the ``skin_*`` properties of the operator or scene settings."""
+    values = {name[len("skin_"):]: getattr(props, name) for name in SKIN_OPTION_NAMES}
+    values["distance"] = values["distance"].lower()
+    values["method"] = values["method"].lower()
+    return SkinSettings(**values)
+
+
+def rig_settings_from(props) -> RigSettings:
+    """RigSettings from the ``rig_*`` properties of an operator or the scene settings."""
+    return RigSettings(**{name[len("rig_"):]: getattr(props, name) for name in RIG_OPTION_NAMES})
 
 
 classes = (AutoRigSceneSettings,)
