@@ -39,6 +39,7 @@ import time
 
 from autorig_addon.core.rigging import predict
 from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD, skin_weights
+from autorig_addon.core.skinning.options import SkinningOptions
 from bench_skinning import character
 from memory import _status_mib, peak_rss_added
 
@@ -54,7 +55,7 @@ AUTO_RIG_SIZES = ("5k",)
 def auto_rig(mesh):
     """The one-click core path: a skeleton, then its skin weights."""
     skeleton = predict.predict_skeleton(mesh)
-    return skeleton, skin_weights(mesh, skeleton, DEFAULT_SKIN_METHOD)
+    return skeleton, skin_weights(mesh, skeleton, SkinningOptions(method=DEFAULT_SKIN_METHOD))
 
 
 def measured(function, seconds: list, peaks: dict, key: str):

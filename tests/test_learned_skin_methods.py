@@ -11,6 +11,7 @@ plainest input there is.
 import argparse
 import json
 import re
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -29,10 +30,9 @@ from autorig_addon.core.skinning.methods import (
     GEOMETRIC_OPTIONS,
     SKIN_METHOD_LABELS,
     SKIN_METHODS,
-    geometric_option_default,
-    ignored_options,
     skin_weights,
 )
+from autorig_addon.core.skinning.options import SkinningOptions, ignored_options
 from geometry_fixtures import cylinder, two_bone_skeleton
 
 #: Height of the test tube; its two bones meet at half of it.
@@ -92,18 +92,19 @@ def test_the_methods_are_the_geometric_one_and_the_networks():
 
 def test_an_unknown_method_is_refused_with_the_choices():
     with pytest.raises(InputError, match=f"^{re.escape(UNKNOWN_METHOD)}$"):
-        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), "magic")
+        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), SkinningOptions(method="magic"))
 
 
 def test_an_option_no_method_has_is_a_programming_error():
-    with pytest.raises(TypeError, match="skin_weights\\(\\) got unknown options: heat"):
-        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), GEOMETRIC, heat=2.0)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'heat'"):
+        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), SkinningOptions(method=GEOMETRIC, heat=2.0))
 
 
 def test_geometric_runs_geometric_weights_with_every_option():
     mesh, skeleton = tube(), two_bone_skeleton(TUBE_HEIGHT)
-    chosen = skin_weights(mesh, skeleton, GEOMETRIC, max_influences=1, resolution=RESOLUTION, distance="geodesic",
-                          falloff=8.0, smoothing_iterations=2, smoothing_strength=0.3)
+    chosen = skin_weights(mesh, skeleton, SkinningOptions(GEOMETRIC, max_influences=1, resolution=RESOLUTION,
+                                                          distance="geodesic", falloff=8.0, smoothing_iterations=2,
+                                                          smoothing_strength=0.3))
     direct = geometric.geometric_weights(mesh, skeleton, distance="geodesic", resolution=RESOLUTION, falloff=8.0,
                                          max_influences=1, smoothing_iterations=2, smoothing_strength=0.3)
     assert chosen.bone_names == direct.bone_names
@@ -114,8 +115,9 @@ def test_geometric_runs_geometric_weights_with_every_option():
 def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(network):
     character = generate_character(CHARACTER_SEED, CHARACTER_KIND)
     mesh, skeleton = character.mesh, character.skeleton
-    chosen = skin_weights(mesh, skeleton, network, max_influences=1, resolution=RESOLUTION, distance="geodesic",
-                          falloff=8.0, smoothing_iterations=2, smoothing_strength=0.3)
+    chosen = skin_weights(mesh, skeleton, SkinningOptions(network, max_influences=1, resolution=RESOLUTION,
+                                                          distance="geodesic", falloff=8.0, smoothing_iterations=2,
+                                                          smoothing_strength=0.3))
     direct = learned_weights(mesh, skeleton, network, max_influences=1, resolution=RESOLUTION)
     deform_names = tuple(name for name, deforms in zip(skeleton.names, skeleton.deform) if deforms)
     assert chosen.bone_names == direct.bone_names == deform_names
@@ -125,13 +127,13 @@ def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(networ
 def test_rignet_refuses_a_skeleton_smaller_than_its_candidate_set():
     assert TWO_BONE_METHODS == ("geometric", "heterskinnet", "skinningnet")
     with pytest.raises(InputError, match=f"^{re.escape(RIGNET_TOO_FEW_BONES)}$"):
-        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), "rignet", resolution=RESOLUTION)
+        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), SkinningOptions("rignet", resolution=RESOLUTION))
 
 
 @pytest.mark.parametrize("method", TWO_BONE_METHODS)
 def test_each_method_sends_each_end_of_a_two_bone_tube_to_its_bone(method):
     mesh = tube()
-    weights = skin_weights(mesh, two_bone_skeleton(TUBE_HEIGHT), method, resolution=RESOLUTION)
+    weights = skin_weights(mesh, two_bone_skeleton(TUBE_HEIGHT), SkinningOptions(method, resolution=RESOLUTION))
     assert_valid_weights(weights.matrix, geometric.DEFAULT_MAX_INFLUENCES)
     assert_ends_on_their_bones(weights.matrix, mesh.vertices[:, 2])
 
@@ -139,21 +141,21 @@ def test_each_method_sends_each_end_of_a_two_bone_tube_to_its_bone(method):
 @pytest.mark.parametrize("method", SKIN_METHODS)
 def test_each_method_weights_every_vertex_of_a_generated_character_within_the_limit(method):
     character = generate_character(CHARACTER_SEED, CHARACTER_KIND)
-    weights = skin_weights(character.mesh, character.skeleton, method, max_influences=MAX_INFLUENCES,
-                           resolution=RESOLUTION)
+    weights = skin_weights(character.mesh, character.skeleton,
+                           SkinningOptions(method, max_influences=MAX_INFLUENCES, resolution=RESOLUTION))
     assert weights.matrix.shape == (character.mesh.vertex_count, int(character.skeleton.deform.sum()))
     assert_valid_weights(weights.matrix, MAX_INFLUENCES)
 
 
 def test_ignored_options_are_the_changed_geometric_ones_with_a_network():
-    assert geometric_option_default("distance") == geometric.DEFAULT_DISTANCE
-    assert geometric_option_default("falloff") == geometric.DEFAULT_FALLOFF
-    assert geometric_option_default("smoothing_iterations") == geometric.DEFAULT_SMOOTHING_ITERATIONS
-    defaults = {name: geometric_option_default(name) for name in GEOMETRIC_OPTIONS}
-    changed = {**defaults, "falloff": 8.0, "distance": "geodesic"}
-    assert ignored_options("rignet", changed) == ("distance", "falloff")
-    assert ignored_options("rignet", defaults) == ()
-    assert ignored_options(GEOMETRIC, changed) == ()
+    defaults = SkinningOptions(method="rignet")
+    assert defaults.distance == geometric.DEFAULT_DISTANCE
+    assert defaults.falloff == geometric.DEFAULT_FALLOFF
+    assert defaults.smoothing_iterations == geometric.DEFAULT_SMOOTHING_ITERATIONS
+    changed = replace(defaults, falloff=8.0, distance="geodesic")
+    assert ignored_options(changed) == ("distance", "falloff")
+    assert ignored_options(defaults) == ()
+    assert ignored_options(replace(changed, method=GEOMETRIC)) == ()
 
 
 # --------------------------------------------------------------------------- eval
@@ -313,7 +315,8 @@ def test_an_unknown_method_from_python_is_refused_before_any_work(clean_scene):
 
     armature, body = tube_scene()
     with pytest.raises(InputError, match=f"^{re.escape(UNKNOWN_METHOD)}$"):
-        plan_skin(armature, [body], SkinSettings(method="magic"), bpy.context.evaluated_depsgraph_get())
+        plan_skin(armature, [body], SkinSettings(SkinningOptions(method="magic")),
+                  bpy.context.evaluated_depsgraph_get())
 
 
 def test_a_network_run_reports_progress_and_stops_on_esc(clean_scene):
@@ -324,7 +327,7 @@ def test_a_network_run_reports_progress_and_stops_on_esc(clean_scene):
 
     armature, body = tube_scene()
     before = scene_state([armature, body])
-    plan = plan_skin(armature, [body], SkinSettings(method="heterskinnet", resolution=RESOLUTION),
+    plan = plan_skin(armature, [body], SkinSettings(SkinningOptions(method="heterskinnet", resolution=RESOLUTION)),
                      bpy.context.evaluated_depsgraph_get())
     reports = []
     compute_skin(plan, lambda fraction, message: reports.append((fraction, message)))

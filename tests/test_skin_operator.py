@@ -11,6 +11,7 @@ from autorig_addon.blender.jobs.skin import SkinJob
 from autorig_addon.blender.operators.skin import AUTORIG_OT_skin_weights
 from autorig_addon.blender.progress import PROGRESS_STEPS
 from autorig_addon.core.errors import Cancelled
+from autorig_addon.core.skinning.options import SkinningOptions
 from blender_fixtures import (
     BODY_HEIGHT,
     BODY_RADIUS,
@@ -138,7 +139,7 @@ def test_zero_length_bone_with_a_child_is_measured_to_the_child(clean_scene):
     shrink_bone(armature, LOWER_BONE)
     tails_before = [tuple(bone.tail_local) for bone in armature.data.bones]
     # The geometric method measures along the derived tail exactly (the networks see it only through features).
-    plan = plan_skin(armature, [tube], SkinSettings(method="geometric", resolution=32),
+    plan = plan_skin(armature, [tube], SkinSettings(SkinningOptions(method="geometric", resolution=32)),
                      bpy.context.evaluated_depsgraph_get())
     assert plan.tail_decision.derived == (LOWER_BONE,)
     assert "bone tails derived from the joints" in plan.summary
@@ -195,7 +196,7 @@ def test_write_skin_restores_every_mesh_when_a_later_write_fails(clean_scene, mo
 
     armature = make_armature()
     first, second = unbound_cylinder("First"), unbound_cylinder("Second")
-    plan = skin.plan_skin(armature, [first, second], skin.SkinSettings(resolution=24),
+    plan = skin.plan_skin(armature, [first, second], skin.SkinSettings(SkinningOptions(resolution=24)),
                           bpy.context.evaluated_depsgraph_get())
     weights = skin.compute_skin(plan)
     before = scene_state([armature, first, second])

@@ -15,8 +15,8 @@ picks when nothing is named.
 - **Source, armature, character**: the skinned body a transfer copies
   from (:func:`resolve_source`), the armature and meshes to skin
   (:func:`resolve_skin_inputs`, :func:`skin_objects`), the character to rig
-  (:func:`selected_meshes`, :func:`character_name`), the selected pose
-  bones (:func:`selected_pose_bone_names`).
+  (:func:`selected_meshes`, :func:`character_name`), the bones to transfer
+  (:func:`chosen_bone_names`).
 
 Refusals say how to name what is missing, as the job was started.
 """
@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import bpy
 
 from ..core.errors import InputError
+from ..core.transfer.options import SELECTED_BONES
 from . import convert
 from .armature_binding import bound_armature, is_unbound
 
@@ -191,6 +192,17 @@ def selected_pose_bone_names(armature) -> tuple:
         if selected:
             names.append(pose_bone.name)
     return tuple(names)
+
+
+def chosen_bone_names(names: str, subset: str, armature) -> tuple | None:
+    """The bones to transfer: the comma-separated ``names`` if any, else the
+    selected pose bones of ``armature`` when ``subset`` is
+    ``SELECTED_BONES``, else None (every deform bone)."""
+    if split_names(names):
+        return tuple(split_names(names))
+    if subset == SELECTED_BONES:
+        return selected_pose_bone_names(armature)
+    return None
 
 
 # --------------------------------------------------------------------------- skin: armature and meshes

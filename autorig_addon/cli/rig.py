@@ -5,8 +5,9 @@ Each input holds one character: every mesh of the file except helpers
 (bone shapes, objects hidden from render). A file that already holds an
 armature is refused unless ``--replace``, which removes the armatures, the
 meshes' Armature modifiers and the vertex groups named after their bones
-first. Defaults and bounds are the core's (``core.rigging.predict``,
-``core.skinning.methods``), the ones the Blender panel offers.
+first. The options are made from the rig option table
+(``core.rigging.options.RIG_OPTIONS``), the one the Blender panel is made
+from; ``--skin`` takes the skinning methods of ``core.skinning.methods``.
 """
 
 from __future__ import annotations
@@ -16,9 +17,9 @@ from pathlib import Path
 
 from ..core.errors import InputError
 from ..core.messages import listed_names
-from ..core.rigging import predict
+from ..core.rigging.options import RIG_OPTIONS
 from ..core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHODS
-from .arguments import bounded
+from .arguments import add_options
 from .batch import add_batch_arguments, run_batch
 
 NAME = "rig"
@@ -29,26 +30,7 @@ NO_SKIN = "none"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_batch_arguments(parser)
-    parser.add_argument(
-        "--bandwidth", type=bounded(float, predict.MIN_BANDWIDTH, predict.MAX_BANDWIDTH),
-        default=predict.DEFAULT_BANDWIDTH,
-        help="Level of detail: reach of the clustering of the joint votes as a share of the character's largest "
-             f"side, smaller gives more joints, {predict.MIN_BANDWIDTH:g} to {predict.MAX_BANDWIDTH:g} "
-             f"(default {predict.DEFAULT_BANDWIDTH:g})",
-    )
-    parser.add_argument(
-        "--density-threshold",
-        type=bounded(float, predict.MIN_DENSITY_THRESHOLD, predict.MAX_DENSITY_THRESHOLD),
-        default=predict.DEFAULT_DENSITY_THRESHOLD,
-        help="Joints whose vote mass is below this share of the strongest are dropped, "
-             f"{predict.MIN_DENSITY_THRESHOLD:g} to {predict.MAX_DENSITY_THRESHOLD:g} "
-             f"(default {predict.DEFAULT_DENSITY_THRESHOLD:g})",
-    )
-    parser.add_argument(
-        "--symmetry", action=argparse.BooleanOptionalAction, default=predict.DEFAULT_SYMMETRY,
-        help="Mirror the joints of a left-right symmetric character, with .L/.R names "
-             f"(default {'on' if predict.DEFAULT_SYMMETRY else 'off'})",
-    )
+    add_options(parser, RIG_OPTIONS)
     parser.add_argument(
         "--skin", choices=SKIN_METHODS + (NO_SKIN,), default=DEFAULT_SKIN_METHOD,
         help=f"How the meshes are weighted to the new skeleton ({NO_SKIN}: the armature alone, meshes unbound; "
@@ -88,9 +70,10 @@ def clear_armatures(replace: bool) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     from ..blender.jobs.rig import RigSettings, plan_rig, rig_steps, run_steps
     from ..blender.jobs.skin import SkinSettings
+    from ..core.skinning.options import SkinningOptions
 
     settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry)
-    skin = None if args.skin == NO_SKIN else SkinSettings(method=args.skin)
+    skin = None if args.skin == NO_SKIN else SkinSettings(SkinningOptions(method=args.skin))
 
     def process(input_path, output_path, progress):
         import bpy

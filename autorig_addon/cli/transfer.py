@@ -1,29 +1,27 @@
 """``python -m autorig_addon transfer``: copy skin weights from a body onto garments.
 
-Defaults and bounds are the core's (``core.transfer.options``,
-``core.transfer.combine``), the ones the Blender panel offers.
+The options are made from the transfer's option table
+(``core.transfer.options.TRANSFER_OPTIONS``), the one the Blender panel is
+made from.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 from pathlib import Path
 
 from ..core.errors import InputError
 from ..core.transfer import combine
-from ..core.transfer import options as defaults
-from ..core.transfer.options import TransferOptions
-from .arguments import add_weight_arguments, bounded, fraction, positive
+from ..core.transfer.options import TRANSFER_OPTIONS, TransferOptions
+from .arguments import add_option, add_options, options_from
 from .batch import add_batch_arguments, run_batch
 
 NAME = "transfer"
 HELP = "Copy skin weights from a body onto garments (robust transfer with inpainting)"
 
-#: ``--replace`` choices -> write modes of ``core.transfer.combine``.
-REPLACE_CHOICES = {"transfer": combine.REPLACE, "mix": combine.MIX, "all": combine.REPLACE_ALL}
-#: The ``--replace`` choice meaning the core's default write mode.
-DEFAULT_REPLACE_CHOICE = next(word for word, mode in REPLACE_CHOICES.items() if mode == combine.DEFAULT_REPLACE_MODE)
+#: Options whose command line differs from the panel: the absolute distance
+#: and the write mode are given only to change the defaults.
+_GIVEN_ONLY = ("max_distance", "replace_mode", "mix_factor")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,64 +31,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--target", action="append", default=[], metavar="OBJ",
         help="Mesh to weight (repeat, or comma-separate; default: every mesh not bound to an armature)",
     )
-    parser.add_argument(
-        "--distance-fraction", type=bounded(float, defaults.MIN_DISTANCE_FRACTION, defaults.MAX_DISTANCE_FRACTION),
-        default=defaults.DEFAULT_DISTANCE_FRACTION,
-        help="Match distance as a fraction of the target's bounding-box diagonal, "
-             f"{defaults.MIN_DISTANCE_FRACTION:g} to {defaults.MAX_DISTANCE_FRACTION:g} "
-             f"(default {defaults.DEFAULT_DISTANCE_FRACTION:g})",
-    )
-    parser.add_argument("--max-distance", type=positive, default=None,
-                        help="Match distance in scene units; overrides --distance-fraction")
-    parser.add_argument(
-        "--max-normal-angle", type=bounded(float, defaults.MIN_MAX_NORMAL_ANGLE, defaults.MAX_MAX_NORMAL_ANGLE),
-        default=defaults.DEFAULT_MAX_NORMAL_ANGLE,
-        help=f"Largest normal disagreement for a match, degrees, {defaults.MIN_MAX_NORMAL_ANGLE:g} to "
-             f"{defaults.MAX_MAX_NORMAL_ANGLE:g} (default {defaults.DEFAULT_MAX_NORMAL_ANGLE:g})",
-    )
-    parser.add_argument("--flipped-normals", action=argparse.BooleanOptionalAction, dest="accept_flipped_normals",
-                        default=defaults.DEFAULT_ACCEPT_FLIPPED_NORMALS,
-                        help="Also match opposite normals, for inner layers "
-                             f"(default {'on' if defaults.DEFAULT_ACCEPT_FLIPPED_NORMALS else 'off'})")
-    parser.add_argument(
-        "--smoothing-length",
-        type=bounded(float, defaults.MIN_SMOOTHING_LENGTH, defaults.MAX_SMOOTHING_LENGTH),
-        default=defaults.DEFAULT_SMOOTHING_LENGTH,
-        help="Reach of the smoothing of all transferred weights, as a fraction of the source's bounding-box "
-             f"diagonal, {defaults.MIN_SMOOTHING_LENGTH:g} (off) to {defaults.MAX_SMOOTHING_LENGTH:g} "
-             f"(default {defaults.DEFAULT_SMOOTHING_LENGTH:g}: 1 cm on a 2 m body)",
-    )
-    add_weight_arguments(parser, defaults.DEFAULT_MAX_INFLUENCES, defaults.DEFAULT_SMOOTHING_ITERATIONS,
-                         "Smoothing passes over inpainted vertices", "; 4 for most game engines")
-    parser.add_argument("--mask-group", default=defaults.DEFAULT_MASK_GROUP,
-                        help=f"Target vertex group forcing inpainting (default '{defaults.DEFAULT_MASK_GROUP}')")
-    parser.add_argument("--protect-group", default="", help="Target vertex group that keeps its weights")
+    add_options(parser, TRANSFER_OPTIONS, leave_out=_GIVEN_ONLY)
+    add_option(parser, TRANSFER_OPTIONS["max_distance"], default=None, note="overrides --distance-fraction")
     parser.add_argument("--bones", default="", help="Comma-separated bones to transfer (default: all deform bones)")
-    parser.add_argument("--mix", type=fraction, default=None,
-                        help="Share of the transferred weights when mixing, 0 to 1 (implies --replace mix)")
-    parser.add_argument("--allow-poor-match", action="store_true", default=defaults.DEFAULT_ALLOW_POOR_MATCH,
-                        help="Transfer even when almost nothing matches, another unit scale fits much better, or "
-                             "matches are far from the body, instead of refusing (default off)")
-    parser.add_argument("--replace", choices=tuple(REPLACE_CHOICES), default=None,
-                        help="transfer: refill the transferred bones' groups; mix: blend with existing weights; "
-                             f"all: remove every group first (default {DEFAULT_REPLACE_CHOICE}, or mix with --mix)")
+    add_option(parser, TRANSFER_OPTIONS["mix_factor"], default=None, note="implies --replace mix")
+    replace = TRANSFER_OPTIONS["replace_mode"]
+    add_option(parser, replace, default=None,
+               note=f"default {replace.word_of_choice(replace.default)}, or {replace.word_of_choice(combine.MIX)} "
+                    "with --mix")
 
 
 def transfer_settings(args: argparse.Namespace):
-    """The operator's ``TransferSettings`` from parsed arguments (whose
-    destinations are named after the ``TransferOptions`` fields)."""
+    """The job's ``TransferSettings`` from parsed arguments (whose
+    destinations are named after the options)."""
     from ..blender.jobs.transfer import TransferSettings
     from ..blender.selection import split_names
 
-    replace = args.replace or ("mix" if args.mix is not None else DEFAULT_REPLACE_CHOICE)
-    options = TransferOptions(**{field.name: getattr(args, field.name) for field in dataclasses.fields(TransferOptions)})
+    mode = TRANSFER_OPTIONS["replace_mode"].choice_of_word(args.replace_mode) if args.replace_mode else (
+        combine.MIX if args.mix_factor is not None else combine.DEFAULT_REPLACE_MODE)
     return TransferSettings(
-        options=options,
+        options=options_from(args, TransferOptions),
         mask_group=args.mask_group,
         protect_group=args.protect_group,
         bones=tuple(split_names(args.bones)) if args.bones.strip() else None,
-        replace_mode=REPLACE_CHOICES[replace],
-        mix_factor=combine.DEFAULT_MIX_FACTOR if args.mix is None else args.mix,
+        replace_mode=mode,
+        mix_factor=combine.DEFAULT_MIX_FACTOR if args.mix_factor is None else args.mix_factor,
     )
 
 

@@ -21,14 +21,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.distances.grid import DEFAULT_RESOLUTION
 from ...core.errors import InputError
 from ...core.geometry.outliers import require_finite_positions, rows_for_strays
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback
 from ...core.skeleton.tails import TailDecision, with_reliable_tails
-from ...core.skinning import geometric as skinning
-from ...core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHOD_LABELS, check_skin_method, skin_weights
+from ...core.skinning.methods import SKIN_METHOD_LABELS, check_skin_method, skin_weights
+from ...core.skinning.options import SkinningOptions
 from ...core.types import Mesh, Skeleton, Weights
 from .. import convert
 from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
@@ -45,35 +44,22 @@ MAX_ARMATURE_OFFSET = 0.5
 
 @dataclass(frozen=True)
 class SkinSettings:
-    """Options of a skinning run: the method and the keyword arguments of
-    ``core.skinning.methods.skin_weights`` with the core's defaults, plus
-    how the result is written.
+    """Everything a skinning run needs besides the objects: the core's
+    options and how the result is written.
 
     Attributes
     ----------
-    method : one of ``core.skinning.methods.SKIN_METHODS``
-    distance : "geodesic" (volumetric geodesic, RigNet) or "hollow" (HollowDist, HeterSkinNet); geometric method only
-    resolution : int, voxels along the longest side
-    falloff : float, heat strength (higher: sharper blends); geometric method only
-    max_influences : int, bones per vertex (0 = no limit)
-    smoothing_iterations : int; geometric method only
-    smoothing_strength : float in [0, 1]; geometric method only
+    options : core.skinning.options.SkinningOptions (the method and its settings)
     replace_all : bool, remove every existing vertex group first
     """
 
-    method: str = DEFAULT_SKIN_METHOD
-    distance: str = skinning.DEFAULT_DISTANCE
-    resolution: int = DEFAULT_RESOLUTION
-    falloff: float = skinning.DEFAULT_FALLOFF
-    max_influences: int = skinning.DEFAULT_MAX_INFLUENCES
-    smoothing_iterations: int = skinning.DEFAULT_SMOOTHING_ITERATIONS
-    smoothing_strength: float = skinning.DEFAULT_SMOOTHING_STRENGTH
+    options: SkinningOptions = SkinningOptions()
     replace_all: bool = False
 
     @property
     def method_label(self) -> str:
         """The method's name as the reports say it ("HeterSkinNet")."""
-        return SKIN_METHOD_LABELS[self.method]
+        return SKIN_METHOD_LABELS[self.options.method]
 
 
 @dataclass
@@ -145,7 +131,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         picked them itself (every mesh of a file): helper objects are then
         left out and props on a bone left rigid.
     """
-    check_skin_method(settings.method)
+    check_skin_method(settings.options.method)
     convert.require_armature_object(armature)
     meshes = list(dict.fromkeys(meshes))
     found = meshes
@@ -193,15 +179,10 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
     """(n, deform bones) weights for every vertex of every mesh; no ``bpy``.
     Far strays are left out of the computation and take the weights of the
     nearest kept vertex (``core.geometry.outliers.rows_for_strays``)."""
-    s = plan.settings
     if plan.mesh is None:
         names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
         return Weights(np.zeros((0, len(names))), names)
-    weights = skin_weights(
-        plan.solved, plan.skeleton, s.method, max_influences=int(s.max_influences), resolution=int(s.resolution),
-        progress=progress, distance=s.distance, falloff=float(s.falloff),
-        smoothing_iterations=int(s.smoothing_iterations), smoothing_strength=float(s.smoothing_strength),
-    )
+    weights = skin_weights(plan.solved, plan.skeleton, plan.settings.options, progress=progress)
     if plan.strays is None:
         return weights
     rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, plan.strays)

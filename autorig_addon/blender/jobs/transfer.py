@@ -300,7 +300,8 @@ def compute_transfer(plan: TransferPlan, depsgraph, progress: ProgressCallback |
     count = len(plan.targets)
     for index, target in enumerate(plan.targets):
         report(progress, index / count, f"Weighting '{target.name}'")
-        outcomes.append(_compute_one(plan, target, depsgraph, sub_progress(progress, index / count, (index + 1) / count)))
+        target_progress = sub_progress(progress, index / count, (index + 1) / count)
+        outcomes.append(_compute_one(plan, target, depsgraph, target_progress))
     for binding in plan.rigid:
         summary = binding.note + "".join(f"; {note}" for note in plan.notes.get(binding.obj, []))
         outcomes.append(TargetOutcome(binding.obj, None, None, summary, rigid=binding))

@@ -7,16 +7,16 @@ cancels) or, in background mode, on the main thread.
 from __future__ import annotations
 
 import bpy
-from bpy.props import BoolProperty
 
 from ...core.errors import Cancelled, InputError
+from ...core.rigging.options import REPLACE_BINDING
 from ..jobs.input_checks import mode_poll
 from ..jobs.rig import RigPlan, RigResult, TaskJob, plan_rig, rig_steps, run_steps
 from ..jobs.skin import SkinSettings
 from ..progress import blender_progress
 from ..selection import character_name, selected_meshes
+from ..ui.option_properties import option_property
 from ..ui.properties import (
-    REPLACE_BINDING_DESCRIPTION,
     RIG_OPTION_NAMES,
     SKIN_OPTION_NAMES,
     RigOptionProperties,
@@ -150,7 +150,7 @@ class AUTORIG_OT_auto_rig(_RigOperator, SkinOptionProperties, bpy.types.Operator
     bl_idname = "autorig.auto_rig"
     bl_label = "Auto-Rig"
 
-    rig_replace: BoolProperty(name="Replace Binding", description=REPLACE_BINDING_DESCRIPTION, default=False)
+    rig_replace: option_property(REPLACE_BINDING)
 
     def option_names(self) -> tuple:
         return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace",)

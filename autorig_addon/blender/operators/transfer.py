@@ -2,30 +2,27 @@
 the operator's names or the selection (:mod:`..selection`), the options
 from its properties, the work done by :mod:`..jobs.transfer`."""
 
-import math
-
 import bpy
 from bpy.props import StringProperty
 
 from ...core.errors import Cancelled, InputError
-from ...core.transfer.options import GROUP_MEMBER_THRESHOLD, TransferOptions
+from ...core.transfer.options import GROUP_MEMBER_THRESHOLD
 from .. import convert
 from ..armature_binding import find_armature
 from ..jobs.input_checks import check_mode, mode_poll
-from ..jobs.transfer import TransferSettings, outcome_report, run_transfer
+from ..jobs.transfer import outcome_report, run_transfer
 from ..progress import blender_progress
 from ..selection import (
     PICK_IN_PANEL,
     PICK_IN_SCRIPT,
     HowToPick,
+    chosen_bone_names,
     object_named,
     resolve_source,
     resolve_targets,
-    selected_pose_bone_names,
     selected_targets,
-    split_names,
 )
-from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties, scene_values
+from ..ui.properties import TRANSFER_OPTION_NAMES, TransferOptionProperties, scene_values, transfer_settings_from
 
 
 def scene_defaults(context, is_set) -> dict:
@@ -88,33 +85,6 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             setattr(self, name, value)
         return self._run(context, PICK_IN_PANEL)
 
-    def _settings(self, armature) -> TransferSettings:
-        if split_names(self.bones):
-            bones = tuple(split_names(self.bones))
-        elif self.bone_subset == "SELECTED":
-            bones = selected_pose_bone_names(armature)
-        else:
-            bones = None
-        options = TransferOptions(
-            distance_fraction=self.distance_fraction,
-            max_distance=self.max_distance if self.use_absolute_distance else None,
-            max_normal_angle=math.degrees(self.max_normal_angle),
-            accept_flipped_normals=self.accept_flipped_normals,
-            smoothing_length=self.smoothing_length,
-            smoothing_iterations=self.smoothing_iterations,
-            smoothing_strength=self.smoothing_strength,
-            max_influences=self.max_influences,
-            allow_poor_match=self.allow_poor_match,
-        )
-        return TransferSettings(
-            options=options,
-            mask_group=self.mask_group,
-            protect_group=self.protect_group,
-            bones=bones,
-            replace_mode=self.replace_mode,
-            mix_factor=self.mix_factor,
-        )
-
     def execute(self, context):
         return self._run(context, PICK_IN_SCRIPT)
 
@@ -125,9 +95,9 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
             source = resolve_source(context, self.source, how)
             targets = resolve_targets(context, self.targets, source, how=how)
             depsgraph = context.evaluated_depsgraph_get()
-            settings = self._settings(find_armature(source))
+            bones = chosen_bone_names(self.bones, self.bone_subset, find_armature(source))
             with blender_progress(context, "Transfer weights") as progress:
-                outcomes = run_transfer(source, targets, settings, depsgraph, progress)
+                outcomes = run_transfer(source, targets, transfer_settings_from(self, bones), depsgraph, progress)
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

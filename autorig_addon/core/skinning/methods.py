@@ -3,25 +3,24 @@
 ``geometric`` is :func:`.geometric.geometric_weights` (bone heat diffused
 over the surface from voxel distances); the others are the trained networks
 of :mod:`.learned` (:func:`.learned.predict.learned_weights`). The panel's
-*Method*, the ``skin --method`` option and ``SkinSettings.method`` all take
-their names, labels, descriptions and default from here.
+*Method*, the ``skin --method`` option and ``SkinningOptions.method``
+(:mod:`.options`) all take their names, labels, descriptions and default
+from here.
 
 Some options belong to the geometric method alone
 (:data:`GEOMETRIC_OPTIONS`: the distance kind, the heat falloff, the extra
 smoothing): a network ignores them (the panel disables them, the command
-line says so when one was changed); the resolution of the voxel distances
-and the influence limit apply to every method.
+line says so when one was changed: :func:`.options.ignored_options`); the
+resolution of the voxel distances and the influence limit apply to every
+method.
 """
 
 from __future__ import annotations
 
-import inspect
-
-from ..distances.grid import DEFAULT_RESOLUTION
 from ..errors import InputError
 from ..progress import ProgressCallback
 from ..types import Mesh, Skeleton, Weights
-from .geometric import DEFAULT_MAX_INFLUENCES, geometric_weights
+from .geometric import geometric_weights
 from .learned.networks import NETWORK_NAMES, SKIN_NETWORKS
 from .learned.predict import learned_weights
 
@@ -42,15 +41,10 @@ SKIN_METHOD_DESCRIPTIONS = {
     GEOMETRIC: "Bone heat diffused over the surface from voxel distances through the shape, no training",
     **{name: spec.description for name, spec in SKIN_NETWORKS.items()},
 }
-#: Options of the geometric method alone, by their names here (and in
-#: ``SkinSettings`` and on the command line) -> the keyword of
+#: Options of the geometric method alone: fields of ``SkinningOptions`` (and
+#: command-line options) named as the keywords of
 #: :func:`.geometric.geometric_weights` they set. Networks ignore them.
-GEOMETRIC_OPTIONS = {
-    "distance": "distance",
-    "falloff": "falloff",
-    "smoothing_iterations": "smoothing_iterations",
-    "smoothing_strength": "smoothing_strength",
-}
+GEOMETRIC_OPTIONS = ("distance", "falloff", "smoothing_iterations", "smoothing_strength")
 
 
 def check_skin_method(method: str) -> None:
@@ -59,59 +53,33 @@ def check_skin_method(method: str) -> None:
         raise InputError(f"Unknown skinning method '{method}': use one of {', '.join(SKIN_METHODS)}.")
 
 
-def geometric_option_default(name: str):
-    """The default of the geometric-only option ``name`` (a key of
-    :data:`GEOMETRIC_OPTIONS`), read off :func:`.geometric.geometric_weights`
-    where it is declared."""
-    return inspect.signature(geometric_weights).parameters[GEOMETRIC_OPTIONS[name]].default
-
-
-def ignored_options(method: str, options: dict) -> tuple[str, ...]:
-    """The geometric-only options among ``options`` (name -> value) set to
-    something other than their default, which ``method`` ignores: none for
-    the geometric method, in :data:`GEOMETRIC_OPTIONS` order."""
-    if method == GEOMETRIC:
-        return ()
-    return tuple(name for name in GEOMETRIC_OPTIONS
-                 if name in options and options[name] != geometric_option_default(name))
-
-
-def skin_weights(mesh: Mesh, skeleton: Skeleton, method: str, *, max_influences: int = DEFAULT_MAX_INFLUENCES,
-                 resolution: int = DEFAULT_RESOLUTION, progress: ProgressCallback | None = None,
-                 **geometric_options) -> Weights:
-    """Skin weights of ``mesh`` for the deform bones of ``skeleton`` by ``method``.
+def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressCallback | None = None) -> Weights:
+    """Skin weights of ``mesh`` for the deform bones of ``skeleton`` by ``options.method``.
 
     Parameters
     ----------
     mesh : Mesh
     skeleton : Skeleton; only bones with ``deform`` set get weights
-    method : one of :data:`SKIN_METHODS`
-    max_influences : int >= 0, bones kept per vertex (0: no limit)
-    resolution : int, voxel cells along the longest side of the mesh
+    options : SkinningOptions (:mod:`.options`, which imports this module
+        for the method names): the method (one of :data:`SKIN_METHODS`), the
+        resolution and influence limit every method uses, and the
+        :data:`GEOMETRIC_OPTIONS`, which the networks ignore
     progress : optional ProgressCallback (raising in it stops the run)
-    **geometric_options : keys of :data:`GEOMETRIC_OPTIONS` (``distance``,
-        ``falloff``, ``smoothing_iterations``, ``smoothing_strength``),
-        passed to the geometric method and ignored by the networks
 
     Returns
     -------
     Weights with one column per deform bone (in skeleton order); every row
-    is non-negative, sums to 1 and has at most ``max_influences`` non-zeros
-    (when that is above 0).
+    is non-negative, sums to 1 and has at most ``options.max_influences``
+    non-zeros (when that is above 0).
 
     Raises
     ------
     InputError for an unknown method and for the methods' own bad input
     (no deform bones, no vertices, a network's missing weights file).
-    TypeError for an option that is not in :data:`GEOMETRIC_OPTIONS`.
     """
-    unknown = sorted(set(geometric_options) - set(GEOMETRIC_OPTIONS))
-    if unknown:
-        raise TypeError(f"skin_weights() got unknown options: {', '.join(unknown)}")
-    check_skin_method(method)
-    if method != GEOMETRIC:
-        return learned_weights(mesh, skeleton, method, max_influences=max_influences, resolution=resolution,
-                               progress=progress)
-    keywords = {GEOMETRIC_OPTIONS[name]: value for name, value in geometric_options.items()}
-    return geometric_weights(mesh, skeleton, max_influences=max_influences, resolution=resolution, progress=progress,
-                             **keywords)
+    check_skin_method(options.method)
+    if options.method != GEOMETRIC:
+        return learned_weights(mesh, skeleton, options.method, max_influences=options.max_influences,
+                               resolution=options.resolution, progress=progress)
+    return geometric_weights(mesh, skeleton, max_influences=options.max_influences, resolution=options.resolution,
+                             progress=progress, **{name: getattr(options, name) for name in GEOMETRIC_OPTIONS})
