@@ -13,7 +13,11 @@ from autorig_addon.core.nn.spec import shipped_weights
 from autorig_addon.core.rigging.joint_features import VERTEX_FEATURES, JointGraph, joint_graph, solid_depth
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
 from autorig_addon.core.rigging.tree_features import (
-    PAIR_FEATURES, ROOT_FEATURES, candidate_pairs, pair_features, root_features,
+    PAIR_FEATURES,
+    ROOT_FEATURES,
+    candidate_pairs,
+    pair_features,
+    root_features,
 )
 from autorig_addon.core.skinning.learned import predict
 from autorig_addon.core.skinning.learned.features import PRIOR_FLOOR, skin_graph
@@ -27,7 +31,10 @@ pytestmark = pytest.mark.torch
 
 from autorig_addon.core.nn.graph import mesh_edges  # noqa: E402
 from autorig_addon.training.nn.modules import (  # noqa: E402
-    NetworkModule, as_tensors, load_module_weights, module_weights,
+    NetworkModule,
+    as_tensors,
+    load_module_weights,
+    module_weights,
 )
 from autorig_addon.training.nn.torch_kernels import TORCH  # noqa: E402
 from autorig_addon.training.rigging.training_set import reference_skeleton  # noqa: E402

@@ -9,7 +9,15 @@ from autorig_addon.core.nn.aggregation import AGGREGATION_NAMES, STD_VARIANCE_FL
 from autorig_addon.core.nn.convolution import edge_convolution, edge_messages, multi_aggregator_convolution
 from autorig_addon.core.nn.layers import mlp, standardised
 from autorig_addon.core.nn.numpy_kernels import (
-    NUMPY, gather, leaky_relu, linear, masked_row_softmax, relu, scatter, segment_counts, sigmoid,
+    NUMPY,
+    gather,
+    leaky_relu,
+    linear,
+    masked_row_softmax,
+    relu,
+    scatter,
+    segment_counts,
+    sigmoid,
 )
 
 # 4 nodes, 5 edges (not sorted by receiver); node 3 receives nothing.

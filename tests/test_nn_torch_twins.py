@@ -15,7 +15,10 @@ import pytest
 
 from autorig_addon.core.nn.aggregation import AGGREGATION_NAMES, aggregate
 from autorig_addon.core.nn.convolution import (
-    edge_convolution, edge_messages, gmedge_block, multi_aggregator_convolution,
+    edge_convolution,
+    edge_messages,
+    gmedge_block,
+    multi_aggregator_convolution,
 )
 from autorig_addon.core.nn.layers import mlp
 from autorig_addon.core.nn.numpy_kernels import NUMPY, PADDED_BLOCK_SIZE_LIMIT
@@ -27,7 +30,10 @@ torch = pytest.importorskip("torch")
 pytestmark = pytest.mark.torch
 
 from autorig_addon.training.nn.modules import (  # noqa: E402
-    NetworkModule, load_module_weights, module_weights, save_module,
+    NetworkModule,
+    load_module_weights,
+    module_weights,
+    save_module,
 )
 from autorig_addon.training.nn.torch_kernels import TORCH  # noqa: E402
 

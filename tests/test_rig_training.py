@@ -16,7 +16,11 @@ torch = pytest.importorskip("torch")
 pytestmark = pytest.mark.torch
 
 from autorig_addon.training.rigging.train import (  # noqa: E402
-    JITTER_COPIES, connectivity_data, holdout_j2j, train_connectivity_network, train_joint_network,
+    JITTER_COPIES,
+    connectivity_data,
+    holdout_j2j,
+    train_connectivity_network,
+    train_joint_network,
 )
 from autorig_addon.training.runs import start_run, write_weights  # noqa: E402
 

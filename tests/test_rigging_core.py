@@ -18,9 +18,9 @@ from autorig_addon.core.geometry.bounding_box import largest_side
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import connectivity, mean_shift, predict, symmetry, tree_features
 from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
-from autorig_addon.training.rigging.training_set import joint_targets
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
 from autorig_addon.core.types import Mesh, Skeleton
+from autorig_addon.training.rigging.training_set import joint_targets
 from geometry_fixtures import box_mesh, cylinder
 
 # --------------------------------------------------------------------------

@@ -9,7 +9,6 @@ import pytest
 
 from autorig_addon.core.nn.graph import mesh_edges
 from autorig_addon.core.skinning.learned import predict
-from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
 from autorig_addon.core.skinning.learned.features import (
     BONE_FEATURES,
     BONE_VECTORS,
@@ -20,6 +19,7 @@ from autorig_addon.core.skinning.learned.features import (
     candidate_targets,
     skin_graph,
 )
+from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
 from autorig_addon.core.types import Mesh, Skeleton
 from autorig_addon.training.skinning.learned import training_set
 from geometry_fixtures import procedural_sample, random_skin_inputs

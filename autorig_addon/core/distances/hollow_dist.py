@@ -63,8 +63,8 @@ from ..types import Mesh
 from .bone_distances import bone_distances, validate_bones
 from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, layer_cost_above, merge_cells, neighbour_node_pairs
 from .grid import DEFAULT_RESOLUTION, NEIGHBOUR_OFFSETS, VoxelGrid, segment_cells
-from .memory_estimate import HOLLOW_MEMORY
 from .line_of_sight import refine_in_sight
+from .memory_estimate import HOLLOW_MEMORY
 
 #: A straight segment from a vertex to a bone counts as a hollow path when,
 #: once it has left the mesh cells around the vertex, it crosses no mesh

@@ -49,8 +49,8 @@ from ..types import Mesh
 from .bone_distances import bone_distances, validate_bones
 from .cell_graph import BoneGraph, assemble_bone_graph, fine_cells, merge_cells, neighbour_node_pairs
 from .grid import DEFAULT_RESOLUTION, VoxelGrid, segment_cells
-from .memory_estimate import GEODESIC_MEMORY
 from .line_of_sight import refine_in_sight
+from .memory_estimate import GEODESIC_MEMORY
 
 #: A jump through the air from a bone to a solid part it does not cross
 #: counts this many times its straight length.

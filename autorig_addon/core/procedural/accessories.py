@@ -14,7 +14,15 @@ from ..skeleton.naming import LEFT_SUFFIX, chain_names
 from .frames import X, Y, Z, axis_frame, normalized
 from .heads import Ellipsoid
 from .parts import PART_DRIVEN
-from .shapes import box_geometry, cone_geometry, ellipsoid_geometry, prism_geometry, ring_segments, sphere_geometry, torus_geometry
+from .shapes import (
+    box_geometry,
+    cone_geometry,
+    ellipsoid_geometry,
+    prism_geometry,
+    ring_segments,
+    sphere_geometry,
+    torus_geometry,
+)
 from .tubes import round_radii
 
 #: Eye radius as a fraction of the head's smallest semi-axis.

@@ -38,8 +38,8 @@ from ...nn.spec import shipped_weights
 from ...progress import ProgressCallback, report, sub_progress
 from ...types import Mesh, Skeleton, Weights
 from ...weights import limit_influences, prune_small
-from ..heat_prior import heat_prior_weights
 from ..geometric import DEFAULT_MAX_INFLUENCES, deform_bones_of, geometric_weights
+from ..heat_prior import heat_prior_weights
 from .features import SkinGraph, skin_graph
 from .networks import SKIN_NETWORKS, skin_network
 from .networks.scoring import PRIOR_KINDS, SkinNetworkSpec, candidate_weights
