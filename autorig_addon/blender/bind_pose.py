@@ -189,7 +189,8 @@ def bind_pose_error(armature_obj, mesh_objects: Sequence, measure_pose: bool = T
                     f"the default pose differs from the rest (bind) pose in {len(moved)} bones: {listed_names(moved)}"
                 )
     if np.isinf(rest_error) or np.isinf(pose_error):
-        reasons.append("a modifier before the Armature modifier changes the vertex count, so positions cannot be compared")
+        reasons.append("a modifier before the Armature modifier changes the vertex count, "
+                       "so positions cannot be compared")
     return BindPoseCheck(rest_error, pose_error, tuple(reasons), len(undeformed))
 
 

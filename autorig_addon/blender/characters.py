@@ -138,7 +138,8 @@ def choose_armature() -> tuple:
     notes = []
     if len(candidates) > 1:
         others = ", ".join(f"'{name}' ({other} vertices)" for other, name, _, _ in candidates[1:])
-        notes.append(f"several armatures deform meshes: using '{armature.name}' ({count} skinned vertices), not {others}")
+        notes.append(f"several armatures deform meshes: using '{armature.name}' ({count} skinned vertices), "
+                     f"not {others}")
     chosen = {mesh.name for mesh in meshes}
     skipped = sorted(
         obj.name for obj in bpy.context.scene.objects if obj.type == "MESH" and obj.name not in chosen

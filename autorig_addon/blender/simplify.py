@@ -102,4 +102,5 @@ def simplify(mesh: Mesh, weights: Weights, target_vertices: int) -> tuple:
         remove_scratch_object(obj)
     result = np.zeros((len(vertices), matrix.shape[1]))
     result[:, columns] = values
-    return Mesh(vertices, triangles, object_names=welded.object_names), Weights(normalize_rows(result), weights.bone_names)
+    return (Mesh(vertices, triangles, object_names=welded.object_names),
+            Weights(normalize_rows(result), weights.bone_names))

@@ -166,10 +166,12 @@ def check_writable_folder(folder: Path, option: str) -> None:
         with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as error:
-        raise UsageError(f"{option}: cannot write in the folder {str(existing)!r} ({error.strerror or error}).") from None
+        raise UsageError(f"{option}: cannot write in the folder {str(existing)!r} "
+                         f"({error.strerror or error}).") from None
 
 
-def run_batch(inputs: list[str], out: str, output_format: str, process: Callable, summary_file: str | None, quiet: bool = False) -> int:
+def run_batch(inputs: list[str], out: str, output_format: str, process: Callable, summary_file: str | None,
+              quiet: bool = False) -> int:
     """Run ``process(input_path, output_path, progress) -> dict`` on every input.
 
     The outputs are checked first (:func:`check_outputs`, a usage error).
@@ -198,7 +200,8 @@ def run_batch(inputs: list[str], out: str, output_format: str, process: Callable
             bar.finish_item(index, name, f"FAILED: {message}")
             continue
         seconds = round(time.perf_counter() - started, 3)
-        summary["succeeded"].append({"input": str(input_path), "output": str(output_path), "seconds": seconds, **details})
+        summary["succeeded"].append({"input": str(input_path), "output": str(output_path), "seconds": seconds,
+                                     **details})
         bar.finish_item(index, name, f"ok -> {output_path}")
     text = json.dumps(summary, indent=2)
     if summary_file:

@@ -90,18 +90,23 @@ TASKS = ("skin", "rig", "transfer")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the ``eval`` arguments (no Blender needed)."""
     methods = "; ".join(f"{task}: " + ", ".join(method_names(task)) for task in TASKS)
-    parser.add_argument("task", choices=TASKS, help="What to evaluate: skin weights, rigs (skeletons) or weight transfer")
-    parser.add_argument("data", nargs="+", metavar="DATA", help="Rigged character files (.blend .glb .gltf .fbx) or folders of them; garments for transfer")
+    parser.add_argument("task", choices=TASKS,
+                        help="What to evaluate: skin weights, rigs (skeletons) or weight transfer")
+    parser.add_argument("data", nargs="+", metavar="DATA",
+                        help="Rigged character files (.blend .glb .gltf .fbx) or folders of them; "
+                             "garments for transfer")
     parser.add_argument("--method", required=True, help=f"Method to evaluate ({methods})")
     parser.add_argument("--out", metavar="FILE", help="Write the JSON report to FILE")
     parser.add_argument("--split", choices=SUBSETS, default="all",
                         help="Keep only the files of this subset of the data split (default all)")
     parser.add_argument("--split-file", metavar="FILE", default=str(DEFAULT_SPLIT_FILE),
                         help="The data split (default: data_split.json at the repository top)")
-    parser.add_argument("--source", metavar="FILE", help="transfer: the weighted body whose weights go onto the garments")
+    parser.add_argument("--source", metavar="FILE",
+                        help="transfer: the weighted body whose weights go onto the garments")
     parser.add_argument("--format", dest="stdout_format", choices=("markdown", "json"), default="markdown",
                         help="What to print on stdout (default markdown)")
-    parser.add_argument("--baseline", metavar="REPORT", help="A JSON report of another method (from --out) to show beside this one")
+    parser.add_argument("--baseline", metavar="REPORT",
+                        help="A JSON report of another method (from --out) to show beside this one")
     parser.add_argument("--quiet", action="store_true", help="No per-character progress lines on stderr")
 
 
@@ -274,6 +279,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
-    sys.stdout.write(json.dumps(report, indent=2) + "\n" if args.stdout_format == "json" else markdown_report(report, baseline))
+    sys.stdout.write(json.dumps(report, indent=2) + "\n" if args.stdout_format == "json"
+                     else markdown_report(report, baseline))
     sys.stdout.flush()
     return EXIT_FAILED if any("error" in entry for entry in report["characters"]) else EXIT_OK

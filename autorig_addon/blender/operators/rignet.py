@@ -25,7 +25,7 @@ def _active_mesh(context):
 
 
 class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
-    """Import a RigNet rig file (joints, hierarchy, skin weights) as an armature; the active mesh is bound if its vertex count matches"""
+    """Import a RigNet rig file (joints, hierarchy, skin weights) as an armature; the active mesh is bound if its vertex count matches"""  # noqa: E501
 
     bl_idname = "autorig.import_rignet"
     bl_label = "Import RigNet Rig"
@@ -53,7 +53,7 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
 
 
 class AUTORIG_OT_export_rignet(bpy.types.Operator, ExportHelper):
-    """Export the active armature's deform bones, and the weights of the selected mesh bound to it, as a RigNet rig file"""
+    """Export the active armature's deform bones, and the weights of the selected mesh bound to it, as a RigNet rig file"""  # noqa: E501
 
     bl_idname = "autorig.export_rignet"
     bl_label = "Export RigNet Rig"

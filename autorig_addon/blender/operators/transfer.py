@@ -54,7 +54,7 @@ def scene_defaults(context, is_set) -> dict:
 
 
 class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
-    """Copy skin weights from the source body onto the target meshes (garments, accessories), inpainting where they do not match"""
+    """Copy skin weights from the source body onto the target meshes (garments, accessories), inpainting where they do not match"""  # noqa: E501
 
     bl_idname = "autorig.transfer_weights"
     bl_label = "Transfer Weights"
@@ -109,7 +109,7 @@ class AUTORIG_OT_transfer_weights(TransferOptionProperties, bpy.types.Operator):
 
 
 class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
-    """Create the inpaint-mask vertex group on the target and start Weight Paint: painted vertices are always inpainted instead of copied"""
+    """Create the inpaint-mask vertex group on the target and start Weight Paint: painted vertices are always inpainted instead of copied"""  # noqa: E501
 
     bl_idname = "autorig.create_transfer_mask"
     bl_label = "Paint Inpaint Mask"
@@ -135,7 +135,8 @@ class AUTORIG_OT_create_transfer_mask(bpy.types.Operator):
             obj = object_named(self.target)
         else:
             settings = getattr(context.scene, "autorig", None)
-            obj = settings.target if settings is not None and settings.target is not None else context.view_layer.objects.active
+            obj = (settings.target if settings is not None and settings.target is not None
+                   else context.view_layer.objects.active)
         convert.require_mesh_object(obj, "mask target")
         return obj
 
