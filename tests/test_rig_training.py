@@ -45,7 +45,7 @@ def examples():
 
 def run(name, examples, seed, epochs):
     record = start_run(RIG_NETWORKS[name], seed=seed, device="cpu", epochs=epochs, learning_rate=None,
-                       score_name="cd_j2j" if name == "joints" else "held_out_loss")
+                       score_name="cd_j2j" if name == "joints" else "cross_entropy")
     train, holdout = examples
     if name == "joints":
         weights = train_joint_network(train, holdout, record)
@@ -72,7 +72,7 @@ def test_a_full_batch_run_learns_and_reports_its_held_out_accuracy(name, example
     weights, record = run(name, examples, seed=1, epochs=30)
     again, _ = run(name, examples, seed=1, epochs=30)
     assert all(np.array_equal(weights[key], again[key]) for key in weights)
-    held_out = [entry["held_out_loss"] for entry in record.history]
+    held_out = [entry["cross_entropy"] for entry in record.history]
     # Logged at the start and at the last epoch (every 100 epochs otherwise).
     assert [entry["epoch"] for entry in record.history] == [0, 30]
     assert record.history[0]["loss"] is None and record.history[-1]["loss"] > 0  # the training loss

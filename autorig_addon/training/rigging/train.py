@@ -153,7 +153,8 @@ def connectivity_loss(spec: NetworkSpec, params: dict, data: dict, device: str) 
         return torch.nn.functional.binary_cross_entropy_with_logits(
             logits, torch.as_tensor(data["pair_labels"], device=device))
     losses = [torch.nn.functional.cross_entropy(
-        spec.forward(TORCH, params, torch.as_tensor(features, device=device))[None], torch.tensor([root], device=device))
+        spec.forward(TORCH, params, torch.as_tensor(features, device=device))[None],
+        torch.tensor([root], device=device))
         for features, root in data["roots"]]
     return torch.stack(losses).mean()
 
@@ -177,7 +178,7 @@ def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, re
 
     def held_loss(weights: dict) -> dict:
         params = {name: torch.as_tensor(value, device=record.device) for name, value in weights.items()}
-        return {"held_out_loss": float(connectivity_loss(spec, params, held_data, record.device))}
+        return {"cross_entropy": float(connectivity_loss(spec, params, held_data, record.device))}
 
     best = fit(module, lambda: [lambda: connectivity_loss(spec, module.params(), train_data, record.device)],
                held_loss, record=record, steps_per_epoch=1, log_every=FULL_BATCH_LOG_EVERY)
@@ -196,7 +197,7 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     """
     spec = rig_network(network)
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
-                       score_name="cd_j2j" if network == "joints" else "held_out_loss")
+                       score_name="cd_j2j" if network == "joints" else "cross_entropy")
     folder = Path(examples_dir or default_examples_dir(seed))
     examples = build_examples(training_samples(Path(sample_dir)), folder, seed)
     names = sorted(examples)
