@@ -313,7 +313,8 @@ def find_blender_extension_builder() -> tuple[str, str]:
             "install it with 'pip install bpy==5.0.1'."
         )
     bpy_dir = list(spec.submodule_search_locations)[0]
-    builders = sorted(glob.glob(os.path.join(glob.escape(bpy_dir), "*", "scripts", "addons_core", "bl_pkg", "cli", "blender_ext.py")))
+    builders = sorted(glob.glob(os.path.join(glob.escape(bpy_dir), "*", "scripts", "addons_core", "bl_pkg", "cli",
+                                             "blender_ext.py")))
     if not builders:
         raise PackagingError(f"Blender's extension builder (bl_pkg/cli/blender_ext.py) is missing under {bpy_dir}.")
     builder = builders[-1]

@@ -105,7 +105,8 @@ def prune_small(weights: np.ndarray, threshold: float = INFLUENCE_EPSILON) -> np
     return normalize_rows(np.where(keep, weights, 0.0))
 
 
-def mix_weights(existing: np.ndarray, incoming: np.ndarray, factor: float, columns: np.ndarray | None = None) -> np.ndarray:
+def mix_weights(existing: np.ndarray, incoming: np.ndarray, factor: float,
+                columns: np.ndarray | None = None) -> np.ndarray:
     """Blend ``incoming`` into ``existing`` by ``factor`` in [0, 1].
 
     Only ``columns`` (indices, default all) change: those become

@@ -60,8 +60,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "or core/rigging/trained/)")
     parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are (train skin)")
     parser.add_argument("--procedural", type=int, default=0,
-                        help="Also train on this many procedural characters (seeds 0 to N-1, exact skeletons; never held "
-                             "out; default 0)")
+                        help="Also train on this many procedural characters (seeds 0 to N-1, exact skeletons; "
+                             "never held out; default 0)")
 
 
 def run(args: argparse.Namespace) -> int:

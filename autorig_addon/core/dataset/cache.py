@@ -163,7 +163,8 @@ def build_samples(
     return samples
 
 
-def training_samples(sample_dir: str | os.PathLike | None = None, split_file: Optional[str] = None) -> list[CharacterSample]:
+def training_samples(sample_dir: str | os.PathLike | None = None,
+                     split_file: Optional[str] = None) -> list[CharacterSample]:
     """The cached samples of the split's training characters, sorted by name.
 
     Parameters

@@ -134,7 +134,8 @@ def build_hollow_graph(grid: VoxelGrid, heads: np.ndarray, tails: np.ndarray) ->
 
 
 def refine_hollow_in_sight(
-    grid: VoxelGrid, distances: np.ndarray, layers: np.ndarray, vertices: np.ndarray, heads: np.ndarray, tails: np.ndarray
+    grid: VoxelGrid, distances: np.ndarray, layers: np.ndarray, vertices: np.ndarray, heads: np.ndarray,
+    tails: np.ndarray
 ) -> np.ndarray:
     """Straight distances for the pairs whose hollow path crossed no mesh
     layer and whose vertex sees the bone through hollow cells (see

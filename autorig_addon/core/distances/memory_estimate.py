@@ -68,7 +68,8 @@ SURFACE_CELLS_PER_AREA = 1.4
 def mesh_area(mesh: Mesh) -> float:
     """Total area of the triangles of ``mesh``, scene units squared."""
     corners = mesh.vertices[mesh.triangles]
-    return float(0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum())
+    return float(0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
+                                      axis=1).sum())
 
 
 def estimated_memory_bytes(mesh: Mesh, heads: np.ndarray, tails: np.ndarray, resolution: int,

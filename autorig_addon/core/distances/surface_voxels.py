@@ -187,7 +187,8 @@ def _plane_span_over_columns(normal_uvw, anchor_uvw, iu, iv, tolerance):
     heights = []
     for du in (0.0, 1.0):
         for dv in (0.0, 1.0):
-            heights.append(anchor_uvw[:, 2] - (nu * (iu + du - anchor_uvw[:, 0]) + nv * (iv + dv - anchor_uvw[:, 1])) / safe_nw)
+            heights.append(anchor_uvw[:, 2]
+                           - (nu * (iu + du - anchor_uvw[:, 0]) + nv * (iv + dv - anchor_uvw[:, 1])) / safe_nw)
     heights = np.stack(heights, axis=1)
     w_low = np.where(flat, np.floor(heights.min(axis=1) - tolerance), -np.inf)
     w_high = np.where(flat, np.floor(heights.max(axis=1) + tolerance), np.inf)

@@ -92,7 +92,8 @@ def volumetric_geodesic_distances(
 
 
 def refine_geodesic_in_sight(
-    grid: VoxelGrid, distances: np.ndarray, layers: np.ndarray, vertices: np.ndarray, heads: np.ndarray, tails: np.ndarray
+    grid: VoxelGrid, distances: np.ndarray, layers: np.ndarray, vertices: np.ndarray, heads: np.ndarray,
+    tails: np.ndarray
 ) -> np.ndarray:
     """Straight distances where the segment from the vertex to the bone stays
     in solid cells (:func:`.line_of_sight.refine_in_sight`); ``layers`` is

@@ -100,9 +100,11 @@ def markdown_report(report: dict, baseline: Optional[dict] = None) -> str:
     summary = report["summary"]
     # The baseline is summarised over the characters both reports scored, so the means compare like with like.
     base_summary = summarise(task, list(base_entries.values())) if baseline else {}
-    base_rows = dict(base_summary.get("categories", {}), **({"**overall**": base_summary["overall"]} if base_summary else {}))
+    base_rows = dict(base_summary.get("categories", {}),
+                     **({"**overall**": base_summary["overall"]} if base_summary else {}))
     shown = [key for key in keys if key in summary["overall"]["mean"]]
-    heading = "### Summary (mean / median)" if not baseline else f"### Summary (mean: {report['method']} / {baseline['method']})"
+    heading = ("### Summary (mean / median)" if not baseline
+               else f"### Summary (mean: {report['method']} / {baseline['method']})")
     lines += [heading, "", "| category | n | failed | " + " | ".join(shown) + " |", "|---" * (len(shown) + 3) + "|"]
     rows = list(summary["categories"].items()) + [("**overall**", summary["overall"])]
     for category, statistics in rows:

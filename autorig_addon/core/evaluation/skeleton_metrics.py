@@ -65,7 +65,8 @@ def merge_coincident_joints(skeleton: Skeleton, tolerance: float) -> Skeleton:
         With ``g <= j`` joints; ``skeleton`` itself when nothing merges.
     """
     joints = skeleton.joints
-    pairs = cKDTree(joints).query_pairs(float(tolerance), output_type="ndarray") if len(joints) else np.zeros((0, 2), int)
+    pairs = (cKDTree(joints).query_pairs(float(tolerance), output_type="ndarray") if len(joints)
+             else np.zeros((0, 2), int))
     if not len(pairs):
         return skeleton
     count = len(joints)
@@ -185,7 +186,8 @@ def chamfer_j2b(pred: Skeleton, ref: Skeleton, size: float = 1.0) -> float:
     return float(pred_to_ref + ref_to_pred) / 2.0 / checked_size(size)
 
 
-def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0, spacing_fraction: float = BONE_SAMPLE_FRACTION) -> float:
+def chamfer_b2b(pred: Skeleton, ref: Skeleton, size: float = 1.0,
+                spacing_fraction: float = BONE_SAMPLE_FRACTION) -> float:
     """CD-B2B: symmetric Chamfer distance between points sampled on bones.
 
     Both skeletons' bones (:func:`bone_segments`) are sampled with

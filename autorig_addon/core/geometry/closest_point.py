@@ -48,7 +48,8 @@ class SurfacePoints:
         return sum(bary[:, k] * values[corners[:, k]] for k in range(3))
 
 
-def closest_points_on_triangles(P: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def closest_points_on_triangles(P: np.ndarray, A: np.ndarray, B: np.ndarray,
+                                C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Closest point to each ``P[i]`` on triangle ``(A[i], B[i], C[i])``.
 
     Ericson, *Real-Time Collision Detection*, 5.1.5, written over arrays.

@@ -131,7 +131,8 @@ def stray_vertices(vertices: np.ndarray) -> np.ndarray:
     return np.linalg.norm(outside, axis=1) > STRAY_DISTANCE_FACTOR * size
 
 
-def without_vertices(vertices: np.ndarray, triangles: np.ndarray, drop: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def without_vertices(vertices: np.ndarray, triangles: np.ndarray,
+                     drop: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The mesh with the ``drop`` vertices and every triangle touching them removed.
 
     Parameters
@@ -180,7 +181,8 @@ def rows_for_strays(kept_rows: np.ndarray, vertices: np.ndarray, triangles: np.n
     if not drop.any():
         return rows
     vertices = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
-    pairs = edges(np.asarray(triangles, dtype=np.int64).reshape(-1, 3)) if len(triangles) else np.zeros((0, 2), np.int64)
+    pairs = (edges(np.asarray(triangles, dtype=np.int64).reshape(-1, 3)) if len(triangles)
+             else np.zeros((0, 2), np.int64))
     both = drop[pairs].all(axis=1)
     joined = sp.coo_matrix((np.ones(both.sum()), (pairs[both, 0], pairs[both, 1])), shape=(n, n))
     _, group = connected_components(joined, directed=False)

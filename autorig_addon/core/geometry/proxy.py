@@ -159,7 +159,8 @@ def simplified_proxy(mesh: Mesh, target_vertices: int) -> Proxy:
         labels, size = _cluster_for_count(V, F, int(target_vertices))
     count = int(labels.max()) + 1
     members = np.bincount(labels, minlength=count)
-    proxy_V = np.stack([np.bincount(labels, V[:, axis], minlength=count) for axis in range(3)], axis=1) / members[:, None]
+    proxy_V = (np.stack([np.bincount(labels, V[:, axis], minlength=count) for axis in range(3)], axis=1)
+               / members[:, None])
     proxy_F = _proxy_triangles(proxy_V, labels[F], size)
     proxy = Mesh(proxy_V, proxy_F, object_names=mesh.object_names[:1])
     welded_rows = _interpolation(V, F, labels, proxy)
@@ -300,7 +301,8 @@ def _closest_in_lists(points: np.ndarray, clusters: np.ndarray, lists: sp.csr_ma
         base = cumulative[start - 1] if start else 0
         stop = max(int(np.searchsorted(cumulative, base + CARRY_PAIRS_PER_BATCH, side="right")), start + 1)
         batch = slice(start, stop)
-        triangle[batch], barycentric[batch] = _closest_pairs(points[batch], clusters[batch], counts[batch], lists, proxy)
+        triangle[batch], barycentric[batch] = _closest_pairs(points[batch], clusters[batch], counts[batch], lists,
+                                                              proxy)
         start = stop
     return triangle, barycentric
 

@@ -125,7 +125,8 @@ def weld_objects(mesh: Mesh) -> tuple[list[Mesh], np.ndarray]:
     for index in range(len(mesh.object_names)):
         part = mesh.object_slice(index)
         inside = ((mesh.triangles >= part.start) & (mesh.triangles < part.stop)).all(axis=1)
-        vertices, triangles, to_welded = weld_vertices(mesh.vertices[part], mesh.triangles[inside] - part.start, tolerance)
+        vertices, triangles, to_welded = weld_vertices(mesh.vertices[part], mesh.triangles[inside] - part.start,
+                                                       tolerance)
         parts.append(Mesh(vertices, triangles, object_names=(mesh.object_names[index],)))
         maps.append(to_welded + offset)
         offset += len(vertices)

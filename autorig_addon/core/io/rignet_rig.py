@@ -423,7 +423,8 @@ def _weights_from_skin(
     if np.any(counts > 1):
         duplicate = int(np.flatnonzero(counts > 1)[0])
         repeated = [records.skin_lines[k] for k in np.flatnonzero(vertices == unique_vertices[duplicate])]
-        raise InputError(f"Vertex {unique_vertices[duplicate]} has several '{SKIN_KEYWORD}' lines (lines {repeated[:4]}).")
+        raise InputError(f"Vertex {unique_vertices[duplicate]} has several '{SKIN_KEYWORD}' lines "
+                         f"(lines {repeated[:4]}).")
     largest = int(vertices.max())
     if vertex_count is None:
         vertex_count = largest + 1
@@ -482,7 +483,8 @@ def _skin_text(skeleton: Skeleton, weights: Weights) -> str:
     if not len(rows):
         return ""
     names = np.asarray(weights.bone_names, dtype=object)
-    pair_text = " " + names[columns] + " " + np.asarray(list(map(_float_text, matrix[rows, columns].tolist())), dtype=object)
+    pair_text = (" " + names[columns] + " "
+                 + np.asarray(list(map(_float_text, matrix[rows, columns].tolist())), dtype=object))
     row_starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
     prefixes = np.asarray([f"{SKIN_KEYWORD} {v}" for v in rows[row_starts].tolist()], dtype=object)
     pair_text[row_starts] = prefixes + pair_text[row_starts]

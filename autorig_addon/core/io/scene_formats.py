@@ -14,4 +14,5 @@ SAVABLE_EXTENSIONS = (".blend", ".glb", ".gltf", ".fbx")
 
 def scene_files(folder: str | Path) -> list[Path]:
     """Every file Blender can load below ``folder`` (any depth), sorted by path."""
-    return [path for path in sorted(Path(folder).rglob("*")) if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]
+    return [path for path in sorted(Path(folder).rglob("*"))
+            if path.is_file() and path.suffix.lower() in LOADABLE_EXTENSIONS]

@@ -60,7 +60,8 @@ def spanning_tree(joint_count: int, pairs: np.ndarray, probabilities: np.ndarray
     cost = {tuple(pair): -np.log(max(float(p), PROBABILITY_FLOOR)) for pair, p in zip(pairs.tolist(), probabilities)}
     everything = np.array([(a, b) for a in range(joint_count) for b in range(a + 1, joint_count)], dtype=np.int64)
     lengths = np.linalg.norm(joints[everything[:, 0]] - joints[everything[:, 1]], axis=1) if len(everything) else []
-    costs = np.array([cost.get((a, b), UNSCORED_PAIR_COST + length) for (a, b), length in zip(everything.tolist(), lengths)])
+    costs = np.array([cost.get((a, b), UNSCORED_PAIR_COST + length)
+                      for (a, b), length in zip(everything.tolist(), lengths)])
     order = everything[np.argsort(costs, kind="stable")].tolist()
     mirror = np.asarray(mirror)
     twin = np.where(mirror >= 0, mirror, np.arange(joint_count))

@@ -95,7 +95,8 @@ def surface_points(vertices: np.ndarray, triangles: np.ndarray, count: int = SUR
     areas = triangle_double_areas(vertices, triangles) if len(triangles) else np.zeros(0)
     total = float(areas.sum())
     if not np.isfinite(total) or total <= 0.0:
-        raise InputError("The mesh has no faces with an area, so there is no surface to compare with the training characters.")
+        raise InputError("The mesh has no faces with an area, so there is no surface to compare with the training "
+                         "characters.")
     rng = np.random.default_rng(seed)
     chosen = triangles[rng.choice(len(triangles), size=int(count), p=areas / total)]
     root, second = np.sqrt(rng.random(int(count)))[:, None], rng.random(int(count))[:, None]

@@ -225,7 +225,8 @@ class _Frame:
                 reach[joint] = max(reach[joint], step[child] + reach[child])
         low, high = joints.min(axis=0), joints.max(axis=0)
         floor = float(joints[paired, 2].min()) if paired.any() else float(low[2])
-        midline_x = float(np.median((joints[paired, 0] + twin_x[paired]) / 2.0)) if paired.any() else float(joints[0, 0])
+        midline_x = (float(np.median((joints[paired, 0] + twin_x[paired]) / 2.0)) if paired.any()
+                     else float(joints[0, 0]))
         return cls(joints, parents, mirror, side, children, step, reach, floor, float(high[2] - low[2]),
                    float((high - low).max()), midline_x)
 
@@ -430,7 +431,8 @@ def _head_top(frame: _Frame, trunk: list) -> int:
 def _quadruped_roles(frame: _Frame, grounded: list):
     if len(grounded) != 2 or not all(_on_midline(frame, limb.attach) for limb in grounded):
         return None
-    front, hind = sorted(grounded, key=lambda limb: (frame.joints[limb.attach, 1], frame.joints[limb.root, 1], limb.root))
+    front, hind = sorted(grounded,
+                         key=lambda limb: (frame.joints[limb.attach, 1], frame.joints[limb.root, 1], limb.root))
     # The predictor may hang a pair of legs from a midline joint off the
     # trunk, short of where the legs start: legs set apart at either end count.
     along = max(frame.joints[hind.attach, 1] - frame.joints[front.attach, 1],

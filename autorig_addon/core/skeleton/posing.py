@@ -195,7 +195,8 @@ def linear_blend_skinning(vertices: np.ndarray, weights: np.ndarray, matrices: n
     return posed
 
 
-def posed_vertices(vertices: np.ndarray, weights: np.ndarray, skeleton: Skeleton, local_rotations: np.ndarray) -> np.ndarray:
+def posed_vertices(vertices: np.ndarray, weights: np.ndarray, skeleton: Skeleton,
+                   local_rotations: np.ndarray) -> np.ndarray:
     """The mesh skinned to ``skeleton`` in each of several poses.
 
     :func:`pose_matrices` of every pose, then :func:`linear_blend_skinning`.

@@ -415,7 +415,8 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
         if len(names) == 1:
             message = f"Deform bone '{names[0]}' has zero length and no child to point at: give it a length"
         else:
-            message = f"Deform bones {listed_names(names, quoted=True)} have zero length and no child to point at: give them a length"
+            message = (f"Deform bones {listed_names(names, quoted=True)} have zero length and no child to point at: "
+                       "give them a length")
         raise InputError(f"{message} in Edit Mode.")
     fixed = np.flatnonzero(point_like & ((child >= 0) | between_twins))
     if not len(fixed):
@@ -432,6 +433,6 @@ def with_reliable_tails(skeleton: Skeleton, size: float) -> tuple[Skeleton, Tail
     one = len(names) == 1
     ending = "now end at the child they continue" if not len(twin_parents) else (
         "now end at the child they continue, or continue their parent's line between mirrored children")
-    reason = (f"{listed_names(names, quoted=True)} {'is' if one else 'are'} shorter than {100 * POINT_LIKE_FRACTION:.2g} % of the "
-              f"character and {ending}")
+    reason = (f"{listed_names(names, quoted=True)} {'is' if one else 'are'} shorter than "
+              f"{100 * POINT_LIKE_FRACTION:.2g} % of the character and {ending}")
     return replace(skeleton, tails=tails), TailDecision(names, False, reason)

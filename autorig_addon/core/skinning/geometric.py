@@ -154,7 +154,8 @@ def geometric_weights(
     elif proxy is not None:
         distances = proxy.average(distances)
     report(progress, 0.9, "Diffusing bone heat")
-    weights = heat_diffusion_weights(solved, distances, falloff, sees_nearest_bone(solved.vertices, distances, heads, tails))
+    weights = heat_diffusion_weights(solved, distances, falloff,
+                                     sees_nearest_bone(solved.vertices, distances, heads, tails))
     weights = smooth_over_edges(weights, solved.triangles, smoothing_iterations, smoothing_strength)
     if proxy is None:
         weights = _nearest_bone_where_empty(_limited(weights, max_influences), lambda empty: distances[empty])
@@ -224,7 +225,8 @@ def _carried(proxy: Proxy, weights: np.ndarray, distances: np.ndarray, max_influ
     def finish(rows: slice, carried: np.ndarray) -> np.ndarray:
         interpolation = proxy.interpolation[rows]
         limited = _limited(carried, max_influences)
-        return _nearest_bone_where_empty(limited, lambda empty: np.asarray(interpolation[np.flatnonzero(empty)] @ distances))
+        return _nearest_bone_where_empty(limited,
+                                         lambda empty: np.asarray(interpolation[np.flatnonzero(empty)] @ distances))
 
     return proxy.carry(weights, finish)
 

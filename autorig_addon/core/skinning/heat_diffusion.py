@@ -31,7 +31,8 @@ DISTANCE_FLOOR_FRACTION = 1e-4
 LOOSE_VERTEX_MASS_FRACTION = 1e-12
 
 
-def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float, heated: np.ndarray | None = None) -> np.ndarray:
+def heat_diffusion_weights(mesh: Mesh, distances: np.ndarray, falloff: float,
+                           heated: np.ndarray | None = None) -> np.ndarray:
     """Unnormalised weights: bone heat diffused over the surface.
 
     The surface is welded at its seams (:func:`..geometry.weld.weld_mesh`) so

@@ -206,7 +206,8 @@ def transfer_weights(
         unprotected = protected
 
     target_diagonal = target.bounding_box_diagonal
-    max_distance = options.max_distance if options.max_distance is not None else options.distance_fraction * target_diagonal
+    max_distance = (options.max_distance if options.max_distance is not None
+                    else options.distance_fraction * target_diagonal)
     # Everything runs on the welded mesh (seams joined) and is expanded at the end.
     welded, to_welded = weld_mesh(target)
     welded_V, welded_F, count = welded.vertices, welded.triangles, welded.vertex_count
@@ -244,7 +245,8 @@ def transfer_weights(
     fallback = matches.weights[:, bones]
     known_weights = fallback.copy()
     if protected.any():
-        known_weights[protected_welded] = _mean_over_copies(kept[:, bones], protected, to_welded, count)[protected_welded]
+        known_weights[protected_welded] = _mean_over_copies(
+            kept[:, bones], protected, to_welded, count)[protected_welded]
         known |= protected_welded
         status[protected_welded] = VertexStatus.PROTECTED
     labels = connected_component_labels(welded_F, count)
@@ -372,7 +374,8 @@ def poor_match_cause(source: TransferSource, target: Mesh, target_normals: np.nd
             "or raise the match distance.")
 
 
-def _unit_factor(source: TransferSource, target: Mesh, target_normals: np.ndarray, options: TransferOptions) -> UnitFactor | None:
+def _unit_factor(source: TransferSource, target: Mesh, target_normals: np.ndarray,
+                 options: TransferOptions) -> UnitFactor | None:
     return likely_unit_factor(source, target, target_normals, options.distance_fraction,
                               options.max_normal_angle, options.accept_flipped_normals)
 
