@@ -57,10 +57,12 @@ def add_helmet_or_hat(ch, head: Ellipsoid, bone: str):
         crown_height = ch.uniform(0.5, 1.5) * head.radii[2]
         crown_radius = ch.uniform(0.6, 0.9) * head.radii[0]
         segments = ring_segments(crown_radius, ch.spacing)
-        crown = prism_geometry(top + [0, 0, 0.5 * crown_height], 0.5 * crown_height, (crown_radius, crown_radius), np.eye(3), segments)
+        crown = prism_geometry(top + [0, 0, 0.5 * crown_height], 0.5 * crown_height, (crown_radius, crown_radius),
+                               np.eye(3), segments)
         ch.rigid("hat", crown, bone)
         brim_radius = ch.uniform(1.3, 2.0) * head.radii[0]
-        brim = prism_geometry(top, 0.04 * head.radii[2], (brim_radius, brim_radius), np.eye(3), ring_segments(brim_radius, ch.spacing))
+        brim = prism_geometry(top, 0.04 * head.radii[2], (brim_radius, brim_radius), np.eye(3),
+                              ring_segments(brim_radius, ch.spacing))
         ch.rigid("hat_brim", brim, bone)
 
 
@@ -71,7 +73,8 @@ def add_horns(ch, head: Ellipsoid, bone: str):
     length = ch.uniform(0.5, 2.0) * head.radii.max()
     radius = ch.uniform(0.12, 0.3) * head.radii.min()
     base = root - 0.3 * length * direction
-    ch.rigid("horn.L", cone_geometry(base, radius, 1.3 * length, axis_frame(direction, X), ch.spacing), bone, mirror=True)
+    ch.rigid("horn.L", cone_geometry(base, radius, 1.3 * length, axis_frame(direction, X), ch.spacing), bone,
+             mirror=True)
 
 
 def add_spikes(ch, bones):
@@ -111,6 +114,7 @@ def add_ponytail(ch, head: Ellipsoid, bone: str):
     start = head.centre + np.array([0.0, 0.8 * head.radii[1], 0.3 * head.radii[2]])
     length = ch.uniform(1.0, 3.0) * head.radii[2]
     directions = [normalized([0.0, 0.8, -0.3]), normalized([0.0, 0.35, -1.0]), normalized([0.0, 0.1, -1.0])]
-    names = ch.rig.add_chain(chain_names("hair", 3), start, directions, [0.3 * length, 0.35 * length, 0.35 * length], bone)
+    names = ch.rig.add_chain(chain_names("hair", 3), start, directions, [0.3 * length, 0.35 * length, 0.35 * length],
+                             bone)
     radius = ch.uniform(0.2, 0.4) * head.radii[0]
     ch.tube("ponytail", names, round_radii([1.0, 0.9, 0.7, 0.3], radius), up=Y, part_type=PART_DRIVEN)

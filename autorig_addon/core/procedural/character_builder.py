@@ -156,7 +156,8 @@ class CharacterBuilder:
         body_vertices, body_triangles, names, body_weights = self.body_surface(body)
         weights = closest_point_weights(vertices, body_vertices, body_triangles, body_weights)
         used = np.flatnonzero(weights.max(axis=0) > 0)
-        self.add_part(Part(name, PART_CLOTH, False, vertices, triangles, tuple(names[k] for k in used), weights[:, used]))
+        self.add_part(Part(name, PART_CLOTH, False, vertices, triangles, tuple(names[k] for k in used),
+                           weights[:, used]))
 
     # -- the body built so far ----------------------------------------------
     def body_surface(self, names=None):

@@ -76,7 +76,8 @@ def add_skirt(ch, driven: bool):
         on_centre = k == 0 or k == count // 2
         suffix = "" if on_centre else LEFT_SUFFIX
         points = centres[[0, middle, rows - 1]] + np.column_stack(
-            [radii[[0, middle, rows - 1], 0] * np.sin(angle), -radii[[0, middle, rows - 1], 1] * np.cos(angle), np.zeros(3)]
+            [radii[[0, middle, rows - 1], 0] * np.sin(angle), -radii[[0, middle, rows - 1], 1] * np.cos(angle),
+             np.zeros(3)]
         )
         if on_centre:
             points[:, 0] = 0.0
@@ -91,14 +92,17 @@ def add_skirt(ch, driven: bool):
     vertex_angles = np.arctan2(vertices[:, 0], -(vertices[:, 1] - centre_y))
     # Periodic linear interpolation between the two chains around each vertex.
     wrapped = np.concatenate([chain_angles, [chain_angles[0] + 2 * np.pi]])
-    position = np.interp(np.mod(vertex_angles - chain_angles[0], 2 * np.pi) + chain_angles[0], wrapped, np.arange(len(wrapped)))
+    position = np.interp(np.mod(vertex_angles - chain_angles[0], 2 * np.pi) + chain_angles[0], wrapped,
+                         np.arange(len(wrapped)))
     lower = np.floor(position).astype(np.int64)
     upper_share = position - lower
     blocks = []
     for k, (_, names) in enumerate(chains):
-        share = np.where(lower % len(chains) == k, 1.0 - upper_share, 0.0) + np.where((lower + 1) % len(chains) == k, upper_share, 0.0)
+        share = (np.where(lower % len(chains) == k, 1.0 - upper_share, 0.0)
+                 + np.where((lower + 1) % len(chains) == k, upper_share, 0.0))
         polyline = rig.path_points(names)
-        along = joint_blend_weights(polyline_arc_lengths(vertices, polyline), cumulative_lengths(polyline), ch.blend, True, False)
+        along = joint_blend_weights(polyline_arc_lengths(vertices, polyline), cumulative_lengths(polyline), ch.blend,
+                                    True, False)
         blocks.append((["spine"] + names, along * share[:, None]))
     names, weights = sum_weight_blocks(blocks)
     ch.add_part(Part("skirt", PART_DRIVEN, False, vertices, triangles, names, weights))
@@ -128,5 +132,6 @@ def add_cape(ch, driven: bool):
     centre_column = vertices.reshape(rows, columns, 3)[:, columns // 2]
     joints = centre_column[np.linspace(0, rows - 1, 4).round().astype(int)]
     names = rig.add_path(chain_names("cape", 3), joints, "spine.003")
-    weights = joint_blend_weights(polyline_arc_lengths(vertices, joints), cumulative_lengths(joints), ch.blend, True, False)
+    weights = joint_blend_weights(polyline_arc_lengths(vertices, joints), cumulative_lengths(joints), ch.blend,
+                                  True, False)
     ch.add_part(Part("cape", PART_DRIVEN, False, vertices, triangles, tuple(["spine.003"] + names), weights))

@@ -97,7 +97,8 @@ def closest_point_weights(points, body_vertices, body_triangles, body_weights):
     same_place = np.linalg.norm(closest[:, :, None, :] - closest[:, None, :, :], axis=3) <= tolerance[:, :, None]
     earlier_twin = (np.tril(same_place, k=-1) & tied[:, None, :]).any(axis=2)
     use = tied & ~earlier_twin
-    candidate_weights = np.einsum("mkc,mkcb->mkb", bary.reshape(len(points), count, 3), body_weights[body_triangles[candidates]])
+    candidate_weights = np.einsum("mkc,mkcb->mkb", bary.reshape(len(points), count, 3),
+                                  body_weights[body_triangles[candidates]])
     return (use[:, :, None] * candidate_weights).sum(axis=1) / use.sum(axis=1, keepdims=True)
 
 

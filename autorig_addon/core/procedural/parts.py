@@ -58,5 +58,6 @@ def mirrored_part(part: Part) -> Part:
     swapped, triangles reversed so the twin still faces outward."""
     return Part(
         mirror_name(part.name), part.part_type, part.closed, part.vertices * MIRROR_X,
-        np.ascontiguousarray(part.triangles[:, ::-1]), tuple(mirror_name(b) for b in part.bone_names), part.weights.copy(),
+        np.ascontiguousarray(part.triangles[:, ::-1]), tuple(mirror_name(b) for b in part.bone_names),
+        part.weights.copy(),
     )

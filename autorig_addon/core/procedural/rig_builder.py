@@ -92,7 +92,8 @@ class RigBuilder:
         if np.linalg.norm(axis) < 1e-9:
             axis = X
         directions = curling_directions(direction, axis, np.radians(bend_deg), count)
-        return self.add_chain(chain_names(base, count), start, directions, shrinking_lengths(count, length, TAIL_SHRINK), parent)
+        return self.add_chain(chain_names(base, count), start, directions,
+                              shrinking_lengths(count, length, TAIL_SHRINK), parent)
 
     def symmetrize(self):
         """Add a ``.R`` twin, mirrored across x = 0, for every ``.L`` bone

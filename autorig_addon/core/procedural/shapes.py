@@ -120,7 +120,8 @@ def ellipsoid_geometry(centre, radii, frame, spacing, cut_angle=0.0):
     tangents = np.repeat(frame[:, 2][None, :], len(theta), axis=0)
     normals = np.repeat(frame[:, 0][None, :], len(theta), axis=0)
     start = centres[0] if cut_angle > 0.0 else centre - radii[2] * frame[:, 2]
-    vertices, triangles, _ = lathe(centres, tangents, normals, ring_radii, segments, start, centre + radii[2] * frame[:, 2])
+    vertices, triangles, _ = lathe(centres, tangents, normals, ring_radii, segments, start,
+                                   centre + radii[2] * frame[:, 2])
     return vertices, triangles
 
 
@@ -159,7 +160,8 @@ def cone_geometry(base_centre, radius, height, frame, spacing):
     axis = frame[:, 2]
     centres = np.asarray(base_centre, dtype=np.float64)[None, :]
     vertices, triangles, _ = lathe(
-        centres, axis[None, :], frame[:, 0][None, :], np.array([[radius, radius]]), segments, centres[0], centres[0] + height * axis
+        centres, axis[None, :], frame[:, 0][None, :], np.array([[radius, radius]]), segments, centres[0],
+        centres[0] + height * axis
     )
     return vertices, triangles
 
@@ -173,7 +175,8 @@ def torus_geometry(centre, major_radii, minor_radius, frame, spacing):
     u = 2.0 * np.pi * np.arange(around) / around
     v = 2.0 * np.pi * np.arange(tube) / tube
     core = major_radii[0] * np.cos(u)[:, None] * frame[:, 0] + major_radii[1] * np.sin(u)[:, None] * frame[:, 1]
-    outward = normalized(np.cos(u)[:, None] / major_radii[0] * frame[:, 0] + np.sin(u)[:, None] / major_radii[1] * frame[:, 1])
+    outward = normalized(np.cos(u)[:, None] / major_radii[0] * frame[:, 0]
+                         + np.sin(u)[:, None] / major_radii[1] * frame[:, 1])
     points = (
         centre
         + core[:, None, :]
@@ -198,7 +201,8 @@ def grid_triangles(rows: int, columns: int) -> np.ndarray:
     j = np.arange(columns - 1)[None, :]
     a, b = i * columns + j, i * columns + j + 1
     c, d = (i + 1) * columns + j + 1, (i + 1) * columns + j
-    return np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)]).astype(np.int64)
+    return np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
+                           np.stack([a, c, d], -1).reshape(-1, 3)]).astype(np.int64)
 
 
 def face_towards(vertices, triangles, direction) -> np.ndarray:

@@ -102,7 +102,8 @@ def tube_shell(points, arc_offset, radius_at, up, spacing):
     lengths = segment_lengths(points)
     per_bone = np.maximum(1, np.ceil(lengths / spacing).astype(np.int64))
     bone = np.repeat(np.arange(len(lengths)), per_bone)
-    fraction = (np.arange(per_bone.sum()) - np.repeat(np.cumsum(per_bone) - per_bone, per_bone)) / np.repeat(per_bone, per_bone)
+    fraction = ((np.arange(per_bone.sum()) - np.repeat(np.cumsum(per_bone) - per_bone, per_bone))
+                / np.repeat(per_bone, per_bone))
     bone = np.append(bone, len(lengths) - 1)
     fraction = np.append(fraction, 1.0)
     centres = points[bone] + fraction[:, None] * (points[bone + 1] - points[bone])
@@ -170,9 +171,11 @@ def tube_part(name, points, bones, radii, up, spacing, blend, part_type, parent=
         before = bones[start - 1] if start > 0 else parent
         after = bones[stop] if stop < len(bones) else child
         weights = joint_blend_weights(
-            arc - joint_arc[start], joint_arc[start:stop + 1] - joint_arc[start], blend, before is not None, after is not None
+            arc - joint_arc[start], joint_arc[start:stop + 1] - joint_arc[start], blend, before is not None,
+            after is not None
         )
-        names = ([before] if before is not None else []) + list(bones[start:stop]) + ([after] if after is not None else [])
+        names = (([before] if before is not None else []) + list(bones[start:stop])
+                 + ([after] if after is not None else []))
         vertex_blocks.append(vertices)
         triangle_blocks.append(triangles + offset)
         weight_blocks.append((names, weights))

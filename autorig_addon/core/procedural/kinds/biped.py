@@ -27,7 +27,8 @@ BIPED_ARM_DROP_DEG = (0.0, 50.0)
 BIPED_ELBOW_BEND_DEG = 25.0
 BIPED_LEG_SPREAD_DEG = 10.0
 #: Shell semi-axes in template metres, at the joints of each chain.
-BIPED_TORSO_RADII = ((0.115, 0.16), (0.105, 0.15), (0.10, 0.135), (0.115, 0.165), (0.075, 0.10), (0.055, 0.055), (0.055, 0.055))
+BIPED_TORSO_RADII = ((0.115, 0.16), (0.105, 0.15), (0.10, 0.135), (0.115, 0.165), (0.075, 0.10), (0.055, 0.055),
+                     (0.055, 0.055))
 BIPED_TORSO_BULGE = (0.0, 0.0, 0.05, 0.12, 0.0, 0.0)
 BIPED_ARM_RADII = ((0.045, 0.045), (0.052, 0.052), (0.04, 0.04), (0.03, 0.03))
 BIPED_ARM_BULGE = (0.0, 0.08, 0.1)
@@ -75,7 +76,8 @@ def build_biped(ch, tail_bones: int = 0) -> str:
     """A humanoid (with a tail of ``tail_bones`` bones when not 0); returns the variant."""
     factor = {name: ch.uniform(*limits) for name, limits in BIPED_PROPORTIONS.items()}
     lengths = {
-        "spine": factor["torso"], "spine.001": factor["torso"], "spine.002": factor["torso"], "spine.003": factor["torso"],
+        "spine": factor["torso"], "spine.001": factor["torso"], "spine.002": factor["torso"],
+        "spine.003": factor["torso"],
         "spine.004": factor["neck"], "spine.005": factor["neck"], "spine.006": factor["head"],
         "thigh.L": factor["leg"], "shin.L": factor["leg"], "upper_arm.L": factor["arm"], "forearm.L": factor["arm"],
         "hand.L": factor["hand"], "foot.L": factor["foot"], "toe.L": factor["foot"], "heel.02.L": factor["foot"],
@@ -97,8 +99,8 @@ def build_biped(ch, tail_bones: int = 0) -> str:
     fingers = _add_finger_bones(ch) if ch.chance("fingers") else []
     tail = []
     if tail_bones:
-        tail = rig.grow_tail("tail", "spine", rig.head("spine") + np.array([0.0, 0.08, 0.0]), normalized([0.0, 1.0, -0.6]),
-                             ch.uniform(0.5, 1.2), tail_bones, ch.uniform(-12.0, 12.0))
+        tail = rig.grow_tail("tail", "spine", rig.head("spine") + np.array([0.0, 0.08, 0.0]),
+                             normalized([0.0, 1.0, -0.6]), ch.uniform(0.5, 1.2), tail_bones, ch.uniform(-12.0, 12.0))
     unit = ch.fit_size(ch.uniform(*SIZE_RANGE["biped"]))
     thick = factor["thickness"] * unit
     limb = thick * factor["limb_thickness"]
@@ -108,15 +110,19 @@ def build_biped(ch, tail_bones: int = 0) -> str:
     ch.tube("torso", torso, scaled_radii(BIPED_TORSO_RADII, thick), up=-Y, child="spine.006", bulge=BIPED_TORSO_BULGE)
     head = vertical_head(rig, "spine.006", BIPED_HEAD_RADII, 0.45)
     ch.rigid("head", head.geometry(ch.spacing), "spine.006", PART_BODY)
-    ch.tube("arm.L", ["shoulder.L", "upper_arm.L", "forearm.L"], scaled_radii(BIPED_ARM_RADII, limb), up=Z, mirror=True, bulge=BIPED_ARM_BULGE)
+    ch.tube("arm.L", ["shoulder.L", "upper_arm.L", "forearm.L"], scaled_radii(BIPED_ARM_RADII, limb), up=Z, mirror=True,
+            bulge=BIPED_ARM_BULGE)
     ch.tube("hand.L", ["hand.L"], scaled_radii(BIPED_HAND_RADII, limb), up=Z, mirror=True)
     for chain in fingers:
-        ch.tube(chain[0].split(".")[0] + ".L", chain, round_radii([1.0, 1.0, 1.0, 0.75], BIPED_FINGER_RADIUS * limb), up=Z, mirror=True)
-    ch.tube("leg.L", ["thigh.L", "shin.L"], scaled_radii(BIPED_LEG_RADII, limb), up=-Y, mirror=True, bulge=BIPED_LEG_BULGE)
+        ch.tube(chain[0].split(".")[0] + ".L", chain, round_radii([1.0, 1.0, 1.0, 0.75], BIPED_FINGER_RADIUS * limb),
+                up=Z, mirror=True)
+    ch.tube("leg.L", ["thigh.L", "shin.L"], scaled_radii(BIPED_LEG_RADII, limb), up=-Y, mirror=True,
+            bulge=BIPED_LEG_BULGE)
     ch.tube("foot.L", ["foot.L", "toe.L"], scaled_radii(BIPED_FOOT_RADII, limb), up=Z, mirror=True)
     if with_breasts:
         radii = np.array([0.6, 0.45, 0.55]) * rig.length("breast.L")
-        ch.rigid("breast.L", ellipsoid_geometry(rig.point_along("breast.L", 0.55), radii, np.eye(3), ch.spacing), "breast.L", PART_BODY, mirror=True)
+        ch.rigid("breast.L", ellipsoid_geometry(rig.point_along("breast.L", 0.55), radii, np.eye(3), ch.spacing),
+                 "breast.L", PART_BODY, mirror=True)
     if tail:
         ch.tube("tail", tail, tapered_radii(len(tail), (1.0, 0.25), 0.05 * thick), up=Z)
     _add_gear(ch, head)
@@ -144,7 +150,8 @@ def _add_gear(ch, head: Ellipsoid):
             origin = np.array([0.0, rig.head(bone)[1], z])
             front = ch.extent_along(origin, -Y, 1.5 * ch.spacing, BIPED_TRUNK)
             centre = origin - (front + 0.2 * radius) * Y
-            ch.rigid(f"button.{k:03d}", ellipsoid_geometry(centre, np.array([radius, 0.5 * radius, radius]), np.eye(3), ch.spacing), bone)
+            ch.rigid(f"button.{k:03d}",
+                     ellipsoid_geometry(centre, np.array([radius, 0.5 * radius, radius]), np.eye(3), ch.spacing), bone)
     if ch.chance("backpack"):
         middle = rig.middle("spine.003")
         back = ch.extent_along(middle, Y, 1.5 * ch.spacing, BIPED_TRUNK)
@@ -156,7 +163,8 @@ def _add_gear(ch, head: Ellipsoid):
         forearm = rig.middle("forearm.L")
         radius = ch.uniform(0.1, 0.16) * height
         centre = forearm - (ch.extent_along(forearm, -Y, ch.spacing, {"arm.L"}) + 0.01 * height) * Y
-        shield = prism_geometry(centre, 0.006 * height, (radius, radius), axis_frame(-Y, Z), ring_segments(radius, ch.spacing))
+        shield = prism_geometry(centre, 0.006 * height, (radius, radius), axis_frame(-Y, Z),
+                                ring_segments(radius, ch.spacing))
         ch.rigid("shield", shield, "forearm.L")
     if ch.chance("skirt"):
         add_skirt(ch, driven=ch.chance("garment_bones"))
@@ -177,7 +185,8 @@ def _add_sword(ch, height):
     pieces = [
         prism_geometry(grip, grip_half, (grip_radius, grip_radius), frame, 6),
         box_geometry(grip - grip_half * Y, np.array([0.005, 0.06, 0.01]) * height, frame),
-        box_geometry(grip - (grip_half + 0.5 * blade) * Y, np.array([0.004, 0.02, 0.5 * blade / height]) * height, frame),
+        box_geometry(grip - (grip_half + 0.5 * blade) * Y, np.array([0.004, 0.02, 0.5 * blade / height]) * height,
+                     frame),
     ]
     for k, piece in enumerate(pieces):
         ch.rigid(f"sword.{k:03d}", piece, "weapon")

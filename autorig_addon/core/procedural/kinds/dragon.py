@@ -45,7 +45,8 @@ def _add_wing_bones(ch, factor):
     attach = middle + np.array([0.5 * width, 0.0, 0.7 * height])
     torso_length = np.linalg.norm(rig.tail("spine.008") - rig.head("spine.004"))
     span = ch.uniform(*DRAGON_WING_SPAN) * torso_length
-    arm = rig.add_chain(chain_names("wing", 2, ".L"), attach, [normalized([1.0, 0.15, 0.5]), normalized([1.0, -0.25, -0.1])],
+    arm = rig.add_chain(chain_names("wing", 2, ".L"), attach,
+                        [normalized([1.0, 0.15, 0.5]), normalized([1.0, -0.25, -0.1])],
                         [0.3 * span, 0.35 * span], "spine.008")
     count = ch.integer(DRAGON_FINGERS[0], DRAGON_FINGERS[1])
     fingers = []
@@ -76,8 +77,9 @@ def _add_membrane(ch, fingers, flank_polyline, torso_bones):
     flank = points_at_fractions(flank_polyline, fractions)
     torso_path = rig.path_points(torso_bones)
     column_points.append(flank)
-    column_weights.append((list(torso_bones), joint_blend_weights(polyline_arc_lengths(flank, torso_path), cumulative_lengths(torso_path),
-                                                                  ch.blend, False, False)))
+    column_weights.append((list(torso_bones),
+                           joint_blend_weights(polyline_arc_lengths(flank, torso_path), cumulative_lengths(torso_path),
+                                               ch.blend, False, False)))
     grid_points, grid_weights = [], []
     for c in range(len(column_points) - 1):
         shares = np.linspace(0.0, 1.0, MEMBRANE_STRIP_SAMPLES + 1)
@@ -106,7 +108,8 @@ def build_dragon(ch) -> str:
     height, width = np.array(QUADRUPED_TORSO_RADII[4]) * factor["thickness"] * unit
     ch.tube("wing_arm.L", arm, round_radii([0.12, 0.09, 0.06], height), up=Y, mirror=True)
     for chain in fingers:
-        ch.tube(chain[0].replace(".L", "") + ".L", chain, round_radii([1.0, 0.8, 0.4], 0.04 * height), up=Z, mirror=True)
+        ch.tube(chain[0].replace(".L", "") + ".L", chain, round_radii([1.0, 0.8, 0.4], 0.04 * height), up=Z,
+                mirror=True)
     hips = rig.head("spine.005") + np.array([0.5 * width, 0.0, 0.5 * height])
     flank = np.stack([rig.head(arm[0]), hips])
     _add_membrane(ch, fingers, flank, list(QUADRUPED_TORSO))

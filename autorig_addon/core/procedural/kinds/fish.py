@@ -17,7 +17,8 @@ from ..tubes import round_radii, scaled_radii
 
 FISH_VARIANTS = ("shark", "reef_fish", "dolphin")
 #: Bones of the body from snout to tail, through the root in the middle.
-FISH_BODY_PATH = ("spine.007", "spine.006", "spine.005", "spine.004", "spine.008", "spine.003", "spine.002", "spine.001", "spine")
+FISH_BODY_PATH = ("spine.007", "spine.006", "spine.005", "spine.004", "spine.008", "spine.003", "spine.002",
+                  "spine.001", "spine")
 #: Body half-height over body length, and width over height, per variant.
 FISH_DEPTH = {"shark": (0.06, 0.09), "reef_fish": (0.15, 0.25), "dolphin": (0.07, 0.1)}
 FISH_ASPECT = {"shark": (0.7, 0.9), "reef_fish": (0.3, 0.5), "dolphin": (0.8, 1.0)}
@@ -34,17 +35,20 @@ FISH_FIN_ROOT_DEPTH = 0.7
 #: Fin shells: part name, bones, (chord, thickness) in template metres at each joint.
 FISH_FINS = (
     ("top_fin", ("top_fin", "top_fin.001"), ((0.16, 0.02), (0.08, 0.012), (0.02, 0.006))),
-    ("side_fin.L", ("shoulder.L", "side_fin.L", "side_fin.001.L"), ((0.1, 0.03), (0.14, 0.025), (0.1, 0.015), (0.03, 0.008))),
+    ("side_fin.L", ("shoulder.L", "side_fin.L", "side_fin.001.L"),
+     ((0.1, 0.03), (0.14, 0.025), (0.1, 0.015), (0.03, 0.008))),
     ("chest_fin.L", ("chest_fin.Bot.L",), ((0.06, 0.012), (0.02, 0.006))),
     ("mid_fin_top", ("mid_fin.Top",), ((0.06, 0.012), (0.02, 0.006))),
     ("mid_fin_bottom", ("mid_fin.Bot",), ((0.06, 0.012), (0.02, 0.006))),
-    ("tail_fin_top", ("back_fin.T.Bk", "back_fin.T.001.Bk", "back_fin.T.002.Bk"), ((0.12, 0.02), (0.09, 0.015), (0.06, 0.01), (0.015, 0.005))),
+    ("tail_fin_top", ("back_fin.T.Bk", "back_fin.T.001.Bk", "back_fin.T.002.Bk"),
+     ((0.12, 0.02), (0.09, 0.015), (0.06, 0.01), (0.015, 0.005))),
     ("tail_fin_bottom", ("back_fin.B.Bk", "back_fin.B.001.Bk"), ((0.1, 0.02), (0.06, 0.012), (0.015, 0.005))),
     ("fluke.L", ("fluke.L", "fluke.001.L"), ((0.14, 0.02), (0.1, 0.015), (0.03, 0.006))),
 )
 FISH_JAW_RADII = ((0.05, 0.09), (0.04, 0.07), (0.02, 0.03))  # (height, width)
 #: Bones whose subtree is moved so their head sits just inside the body surface.
-FISH_FIN_ROOTS = ("top_fin", "shoulder.L", "chest_fin.Bot.L", "mid_fin.Top", "mid_fin.Bot", "back_fin.T.Bk", "back_fin.B.Bk", "jaw.master")
+FISH_FIN_ROOTS = ("top_fin", "shoulder.L", "chest_fin.Bot.L", "mid_fin.Top", "mid_fin.Bot", "back_fin.T.Bk",
+                  "back_fin.B.Bk", "jaw.master")
 
 
 class _FishBody:
@@ -91,7 +95,8 @@ def build_fish(ch) -> str:
     fins, tail_fins, thick = ch.uniform(*FISH_FIN_SIZE), ch.uniform(*FISH_TAIL_FIN_SIZE), ch.uniform(0.8, 1.3)
     if variant == "reef_fish":
         fins *= REEF_FISH_FIN_BOOST
-    fin_bones = {"top_fin", "top_fin.001", "shoulder.L", "side_fin.L", "side_fin.001.L", "chest_fin.Bot.L", "mid_fin.Top", "mid_fin.Bot"}
+    fin_bones = {"top_fin", "top_fin.001", "shoulder.L", "side_fin.L", "side_fin.001.L", "chest_fin.Bot.L",
+                 "mid_fin.Top", "mid_fin.Bot"}
     tail_bones = {"back_fin.T.Bk", "back_fin.T.001.Bk", "back_fin.T.002.Bk", "back_fin.B.Bk", "back_fin.B.001.Bk"}
     lengths = {**{b: fins for b in fin_bones}, **{b: tail_fins for b in tail_bones}}
     keep = {row[0] for row in templates.SHARK}
@@ -103,9 +108,11 @@ def build_fish(ch) -> str:
     if variant == "dolphin":
         start = rig.tail("spine") - 0.3 * rig.length("spine") * rig.direction("spine")
         span = 0.35 * tail_fins
-        rig.add_chain(["fluke.L", "fluke.001.L"], start, [normalized([1.0, 0.6, 0.0]), normalized([1.0, 1.2, 0.0])], [0.55 * span, 0.45 * span], "spine")
+        rig.add_chain(["fluke.L", "fluke.001.L"], start, [normalized([1.0, 0.6, 0.0]), normalized([1.0, 1.2, 0.0])],
+                      [0.55 * span, 0.45 * span], "spine")
     body_length = segment_lengths(rig.path_points(FISH_BODY_PATH)).sum()
-    body = _FishBody(rig.path_points(FISH_BODY_PATH), ch.uniform(*FISH_DEPTH[variant]) * body_length, ch.uniform(*FISH_ASPECT[variant]))
+    body = _FishBody(rig.path_points(FISH_BODY_PATH), ch.uniform(*FISH_DEPTH[variant]) * body_length,
+                     ch.uniform(*FISH_ASPECT[variant]))
     for bone in FISH_FIN_ROOTS:
         if rig.has(bone):
             centre, radial, radius = body.surface(rig.head(bone))
@@ -115,7 +122,8 @@ def build_fish(ch) -> str:
         centre, radial, radius = body.surface(body.path[0] + 0.12 * (body.path[-1] - body.path[0]), Z)
         start = centre + 0.8 * radius * radial
         length = ch.uniform(0.15, 0.35) * body.length
-        lure = rig.add_chain(chain_names("lure", 2), start, [normalized([0.0, -0.4, 1.0]), normalized([0.0, -1.0, -0.2])],
+        lure = rig.add_chain(chain_names("lure", 2), start,
+                             [normalized([0.0, -0.4, 1.0]), normalized([0.0, -1.0, -0.2])],
                              [0.5 * length, 0.5 * length], "spine.007")
     unit = ch.fit_size(ch.uniform(*SIZE_RANGE["fish"]), axis=1)
     ch.settle()

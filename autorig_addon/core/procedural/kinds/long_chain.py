@@ -71,7 +71,8 @@ def build_tentacles(ch) -> str:
         start = 0.3 * outward + np.array([0.0, 0.0, 0.1])
         direction = normalized(outward + np.array([0.0, 0.0, -0.8]))
         directions = curling_directions(direction, np.cross(outward, Z), -np.radians(curl), count)
-        tentacles.append(rig.add_chain(chain_names(f"tentacle_{k + 1}", count, ".L"), start, directions, lengths, body[0]))
+        tentacles.append(rig.add_chain(chain_names(f"tentacle_{k + 1}", count, ".L"), start, directions, lengths,
+                                       body[0]))
     unit = ch.fit_size(ch.uniform(*SIZE_RANGE["long_chain"]), axis=None)
     ch.settle()
     mantle = ch.uniform(0.35, 0.6) * unit

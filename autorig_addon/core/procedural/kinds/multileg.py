@@ -50,7 +50,8 @@ def build_multileg(ch) -> str:
         rig.add("head", [0.0, -0.5 * thorax, 0.01], [0.0, -0.5 * thorax - head_length, 0.02], "thorax")
         count = ch.integer(2, 4) if variant == "insect" else 1
         abdomen_length = ch.uniform(0.35, 0.7)
-        abdomen = rig.add_chain(chain_names("abdomen", count), rig.tail("thorax"), [normalized([0.0, 1.0, ch.uniform(-0.3, 0.3)])] * count,
+        abdomen = rig.add_chain(chain_names("abdomen", count), rig.tail("thorax"),
+                                [normalized([0.0, 1.0, ch.uniform(-0.3, 0.3)])] * count,
                                 [abdomen_length / count] * count, "thorax")
         spots = np.linspace(-0.3, 0.3, pairs) * thorax
         attach = [("thorax", np.array([0.0, y, 0.0])) for y in spots]
@@ -61,18 +62,22 @@ def build_multileg(ch) -> str:
     yaws = np.radians(np.linspace(MULTILEG_LEG_YAW_DEG, -MULTILEG_LEG_YAW_DEG, pairs))
     for k, ((parent, centre), yaw) in enumerate(zip(attach, yaws)):
         start = centre + np.array([0.6 * body_radius, 0.0, -0.2 * body_radius])
-        directions = [np.array([np.cos(e) * np.cos(yaw), -np.cos(e) * np.sin(yaw), np.sin(e)]) for e in np.radians(elevations)]
-        legs.append(rig.add_chain(chain_names(f"leg_{k + 1:02d}", len(shares), ".L"), start, directions, leg_length * np.array(shares), parent))
+        directions = [np.array([np.cos(e) * np.cos(yaw), -np.cos(e) * np.sin(yaw), np.sin(e)])
+                      for e in np.radians(elevations)]
+        legs.append(rig.add_chain(chain_names(f"leg_{k + 1:02d}", len(shares), ".L"), start, directions,
+                                  leg_length * np.array(shares), parent))
     antennae = []
     if variant != "spider" and ch.chance("antennae"):
         start = rig.tail("head") + np.array([0.3 * body_radius, 0.0, 0.3 * body_radius])
         length = ch.uniform(0.2, 0.6)
-        antennae = rig.add_chain(chain_names("antenna", 2, ".L"), start, [normalized([0.4, -1.0, 0.7]), normalized([0.6, -1.0, 0.2])],
+        antennae = rig.add_chain(chain_names("antenna", 2, ".L"), start,
+                                 [normalized([0.4, -1.0, 0.7]), normalized([0.6, -1.0, 0.2])],
                                  [0.5 * length, 0.5 * length], "head")
     wings = []
     if variant == "insect" and ch.chance("insect_wings"):
         start = np.array([0.3 * body_radius, -0.1 * thorax, 0.9 * body_radius])
-        wings = rig.add_chain(["wing.L"], start, [normalized([1.0, ch.uniform(0.3, 1.0), 0.15])], [ch.uniform(0.5, 1.0)], "thorax")
+        wings = rig.add_chain(["wing.L"], start, [normalized([1.0, ch.uniform(0.3, 1.0), 0.15])],
+                              [ch.uniform(0.5, 1.0)], "thorax")
     unit = ch.fit_size(ch.uniform(*SIZE_RANGE["multileg"]), axis=None)
     radius = body_radius * unit
     ch.settle()
@@ -83,7 +88,8 @@ def build_multileg(ch) -> str:
         ch.tube("body", body, np.full((len(body) + 1, 2), radius) * np.array([0.8, 1.0]), up=Z)
     else:
         ch.tube("thorax", ["thorax"], [(0.8 * radius, radius), (0.9 * radius, radius)], up=Z, bulge=[0.2])
-        profile = np.interp(np.linspace(0, 1, len(abdomen) + 1), [0.0, 0.4, 1.0], [1.0, 1.6 if variant == "spider" else 1.3, 0.5])
+        profile = np.interp(np.linspace(0, 1, len(abdomen) + 1), [0.0, 0.4, 1.0],
+                            [1.0, 1.6 if variant == "spider" else 1.3, 0.5])
         ch.tube("abdomen", abdomen, profile[:, None] * radius * np.array([0.9, 1.0]), up=Z, bulge=[0.15] * len(abdomen))
     leg_radius = ch.uniform(0.02, 0.04) * leg_length * unit
     for chain in legs:
@@ -93,7 +99,9 @@ def build_multileg(ch) -> str:
     for wing in wings:
         length = rig.length(wing)
         frame = axis_frame(Z, rig.direction(wing))
-        ch.rigid("wing.L", ellipsoid_geometry(rig.middle(wing), np.array([0.5, 0.22, 0.015]) * length, frame, ch.spacing), wing, mirror=True)
+        ch.rigid("wing.L",
+                 ellipsoid_geometry(rig.middle(wing), np.array([0.5, 0.22, 0.015]) * length, frame, ch.spacing),
+                 wing, mirror=True)
     if ch.chance("eyes"):
         add_eyes(ch, head, "head")
     if abdomen and ch.chance("stinger"):

@@ -45,7 +45,8 @@ def quadruped_skeleton(ch, proportions, tail_bones):
     factor = {name: ch.uniform(*limits) for name, limits in proportions.items()}
     lengths = {name: factor["body"] for name in QUADRUPED_TORSO}
     lengths.update({"spine.009": factor["neck"], "spine.010": factor["neck"], "spine.011": factor["head"]})
-    for name in ("thigh.L", "shin.L", "foot.L", "toe.L", "shoulder.L", "front_thigh.L", "front_shin.L", "front_foot.L", "front_toe.L"):
+    for name in ("thigh.L", "shin.L", "foot.L", "toe.L", "shoulder.L", "front_thigh.L", "front_shin.L", "front_foot.L",
+                 "front_toe.L"):
         lengths[name] = factor["leg"]
     lateral = {"thigh.L": factor["width"], "shoulder.L": factor["width"]}
     root = ch.maybe_root()
@@ -71,14 +72,15 @@ def quadruped_body(ch, factor, unit, tail, ears) -> Ellipsoid:
     """Body shells of a quadruped skeleton scaled by ``unit``; returns the cranium."""
     rig = ch.rig
     thick = factor["thickness"] * unit
-    ch.tube("torso", list(QUADRUPED_TORSO), scaled_radii(QUADRUPED_TORSO_RADII, thick), up=Z, bulge=[0.0, 0.05, 0.05, 0.05, 0.0])
+    ch.tube("torso", list(QUADRUPED_TORSO), scaled_radii(QUADRUPED_TORSO_RADII, thick), up=Z,
+            bulge=[0.0, 0.05, 0.05, 0.05, 0.0])
     ch.tube("neck", ["spine.009", "spine.010"], scaled_radii(QUADRUPED_NECK_RADII, thick), up=Z, child="spine.011")
     ch.tube("snout", ["spine.011"], scaled_radii(QUADRUPED_SNOUT_RADII, thick * np.sqrt(factor["head"])), up=Z)
     cranium = head_ellipsoid(rig, "spine.011", QUADRUPED_CRANIUM_RADII, 0.25, np.sqrt(factor["thickness"]))
     ch.rigid("cranium", cranium.geometry(ch.spacing), "spine.011", PART_BODY)
     ch.tube("tail", tail, tapered_radii(len(tail), QUADRUPED_TAIL_RADII, thick), up=Z)
-    ch.tube("hind_leg.L", ["thigh.L", "shin.L", "foot.L", "toe.L"], scaled_radii(QUADRUPED_HIND_LEG_RADII, thick), up=-Y, mirror=True,
-            bulge=[0.15, 0.05, 0.0, 0.0])
+    ch.tube("hind_leg.L", ["thigh.L", "shin.L", "foot.L", "toe.L"], scaled_radii(QUADRUPED_HIND_LEG_RADII, thick),
+            up=-Y, mirror=True, bulge=[0.15, 0.05, 0.0, 0.0])
     ch.tube("front_leg.L", ["shoulder.L", "front_thigh.L", "front_shin.L", "front_foot.L", "front_toe.L"],
             scaled_radii(QUADRUPED_FRONT_LEG_RADII, thick), up=-Y, mirror=True)
     for ear in ears:

@@ -48,21 +48,25 @@ def build_theropod(ch) -> str:
     """A two-legged dinosaur with small arms and a long tail; returns the variant."""
     rig = ch.rig
     root = ch.maybe_root()
-    torso, neck, head, legs, arms, thick = (ch.uniform(0.6, 1.0), ch.uniform(0.4, 1.0), ch.uniform(0.3, 0.5), ch.uniform(0.8, 1.2),
-                                            ch.uniform(0.3, 1.0), ch.uniform(0.8, 1.3))
-    spine = rig.add_chain(chain_names("spine", 3), [0.0, 0.0, 1.0], [normalized([0, -1, 0.1]), normalized([0, -1, 0.2]), normalized([0, -1, 0.3])],
+    torso, neck, head, legs, arms, thick = (ch.uniform(0.6, 1.0), ch.uniform(0.4, 1.0), ch.uniform(0.3, 0.5),
+                                            ch.uniform(0.8, 1.2), ch.uniform(0.3, 1.0), ch.uniform(0.8, 1.3))
+    spine = rig.add_chain(chain_names("spine", 3), [0.0, 0.0, 1.0],
+                          [normalized([0, -1, 0.1]), normalized([0, -1, 0.2]), normalized([0, -1, 0.3])],
                           torso * np.array([0.36, 0.34, 0.3]), root)
-    neck_bones = rig.add_chain(["spine.003", "spine.004"], rig.tail("spine.002"), [normalized([0, -0.5, 1.0]), normalized([0, -0.8, 0.6])],
+    neck_bones = rig.add_chain(["spine.003", "spine.004"], rig.tail("spine.002"),
+                               [normalized([0, -0.5, 1.0]), normalized([0, -0.8, 0.6])],
                                neck * np.array([0.5, 0.5]), "spine.002")
     rig.add_chain(["head"], rig.tail("spine.004"), [normalized([0, -1.0, -0.15])], [head], "spine.004")
-    rig.add("jaw", rig.head("head") + np.array([0.0, -0.1 * head, -0.12 * head]), rig.tail("head") + np.array([0.0, 0.1 * head, -0.15 * head]), "head")
+    rig.add("jaw", rig.head("head") + np.array([0.0, -0.1 * head, -0.12 * head]),
+            rig.tail("head") + np.array([0.0, 0.1 * head, -0.15 * head]), "head")
     leg = rig.add_chain(["thigh.L", "shin.L", "foot.L", "toe.L"], [0.15, 0.05, 0.95],
-                        [normalized([0.05, -0.45, -1]), normalized([0, 0.5, -1]), normalized([0, -0.2, -1]), normalized([0, -1, -0.05])],
+                        [normalized([0.05, -0.45, -1]), normalized([0, 0.5, -1]), normalized([0, -0.2, -1]),
+                         normalized([0, -1, -0.05])],
                         legs * np.array([0.5, 0.5, 0.3, 0.18]), "spine")
     chest = rig.middle("spine.002")
     arm = rig.add_chain(["upper_arm.L", "forearm.L", "hand.L"], chest + np.array([0.12, 0.0, -0.12]),
-                        [normalized([0.3, -0.5, -0.8]), normalized([0.1, -0.9, 0.1]), normalized([0, -1, -0.3])], arms * np.array([0.2, 0.18, 0.08]),
-                        "spine.002")
+                        [normalized([0.3, -0.5, -0.8]), normalized([0.1, -0.9, 0.1]), normalized([0, -1, -0.3])],
+                        arms * np.array([0.2, 0.18, 0.08]), "spine.002")
     tail, unit = _grow_tail_and_settle(ch, 0.1, (1.0, 2.2), (-3.0, 4.0))
     scale = thick * unit
     ch.tube("torso", spine, scaled_radii(THEROPOD_TORSO_RADII, scale), up=Z, bulge=[0.05, 0.1, 0.05])
@@ -88,13 +92,15 @@ def build_lizard(ch) -> str:
     root = ch.maybe_root()
     legs, thick = ch.uniform(0.7, 1.5), ch.uniform(0.8, 1.4)
     spine = rig.add_chain(chain_names("spine", 3), [0.0, 0.2, 0.2], [-Y] * 3, [0.15, 0.15, 0.15], root)
-    neck = rig.add_chain(["spine.003"], rig.tail("spine.002"), [normalized([0, -1, 0.15])], [ch.uniform(0.06, 0.15)], "spine.002")
+    neck = rig.add_chain(["spine.003"], rig.tail("spine.002"), [normalized([0, -1, 0.15])], [ch.uniform(0.06, 0.15)],
+                         "spine.002")
     rig.add_chain(["head"], rig.tail("spine.003"), [normalized([0, -1, -0.05])], [ch.uniform(0.12, 0.2)], "spine.003")
     sprawl = [normalized([1.0, 0.1, -0.05]), normalized([0.1, 0.1, -1.0]), normalized([0.2, -0.8, -0.1])]
-    hind = rig.add_chain(["thigh.L", "shin.L", "foot.L"], [0.06, 0.17, 0.19], sprawl, legs * np.array([0.12, 0.12, 0.06]), "spine")
+    hind = rig.add_chain(["thigh.L", "shin.L", "foot.L"], [0.06, 0.17, 0.19], sprawl,
+                         legs * np.array([0.12, 0.12, 0.06]), "spine")
     front_sprawl = [normalized([1.0, -0.1, -0.05]), normalized([0.1, -0.1, -1.0]), normalized([0.2, -0.8, -0.1])]
-    front = rig.add_chain(["upper_arm.L", "forearm.L", "hand.L"], rig.tail("spine.002") + np.array([0.06, 0.03, -0.01]), front_sprawl,
-                          legs * np.array([0.1, 0.1, 0.05]), "spine.002")
+    front = rig.add_chain(["upper_arm.L", "forearm.L", "hand.L"], rig.tail("spine.002") + np.array([0.06, 0.03, -0.01]),
+                          front_sprawl, legs * np.array([0.1, 0.1, 0.05]), "spine.002")
     tail, unit = _grow_tail_and_settle(ch, 0.05, (0.6, 1.3), (-2.0, 2.0))
     scale = thick * unit
     ch.tube("torso", spine, scaled_radii(LIZARD_TORSO_RADII, scale), up=Z)

@@ -40,9 +40,11 @@ def build_bird(ch) -> str:
     """A bird with box feathers on its wings and tail; returns the variant."""
     factor = {name: ch.uniform(*limits) for name, limits in BIRD_PROPORTIONS.items()}
     groups = {
-        "wing": ("Wing.L", "Wing.001.L", "Wing.002.L", "w_feather.001.L", "w_feather.002.L", "w_feather.003.L", "w_feather.004.L"),
+        "wing": ("Wing.L", "Wing.001.L", "Wing.002.L", "w_feather.001.L", "w_feather.002.L", "w_feather.003.L",
+                 "w_feather.004.L"),
         "neck": ("spine.006", "neck.001", "neck.002"), "leg": ("thigh.L", "shin.L", "foot.L", "toe.L"),
-        "beak": ("beak.001.T", "beak.002.T", "beak.001.B", "beak.002.B"), "tail": ("spine.002", "spine.001", "spine", "t_feather.L"),
+        "beak": ("beak.001.T", "beak.002.T", "beak.001.B", "beak.002.B"),
+        "tail": ("spine.002", "spine.001", "spine", "t_feather.L"),
         "head": ("head",),
     }
     lengths = {bone: factor[group] for group, bones in groups.items() for bone in bones}
@@ -54,7 +56,8 @@ def build_bird(ch) -> str:
     unit = ch.fit_size(ch.uniform(*SIZE_RANGE["bird"]))
     thick = factor["thickness"] * unit
     ch.settle()
-    ch.tube("torso", ["spine.003", "spine.004", "spine.005"], scaled_radii(BIRD_TORSO_RADII, thick), up=Z, bulge=[0.15, 0.15, 0.1])
+    ch.tube("torso", ["spine.003", "spine.004", "spine.005"], scaled_radii(BIRD_TORSO_RADII, thick), up=Z,
+            bulge=[0.15, 0.15, 0.1])
     ch.tube("tail", ["spine.002", "spine.001", "spine"], scaled_radii(BIRD_TAIL_RADII, thick), up=Z)
     ch.tube("neck", ["spine.006", "neck.001", "neck.002"], scaled_radii(BIRD_NECK_RADII, thick), up=-Y, child="head")
     head = head_ellipsoid(rig, "head", BIRD_HEAD_RADII, 0.25, factor["thickness"] / np.sqrt(factor["head"]))
@@ -63,11 +66,13 @@ def build_bird(ch) -> str:
     ch.tube("beak_upper", ["beak.001.T", "beak.002.T"], scaled_radii(BIRD_UPPER_BEAK_RADII, beak), up=Z)
     ch.tube("beak_lower", ["beak.001.B", "beak.002.B"], scaled_radii(BIRD_LOWER_BEAK_RADII, beak), up=Z)
     ch.tube("leg.L", ["thigh.L", "shin.L", "foot.L", "toe.L"], scaled_radii(BIRD_LEG_RADII, thick), up=-Y, mirror=True)
-    ch.tube("wing.L", ["shoulder.L", "Wing.L", "Wing.001.L", "Wing.002.L"], scaled_radii(BIRD_WING_RADII, thick), up=Z, mirror=True)
+    ch.tube("wing.L", ["shoulder.L", "Wing.L", "Wing.001.L", "Wing.002.L"], scaled_radii(BIRD_WING_RADII, thick), up=Z,
+            mirror=True)
     chord, thickness = BIRD_FEATHER_SHAPE
     for feather in ("w_feather.001.L", "w_feather.002.L", "w_feather.003.L", "w_feather.004.L", "t_feather.L"):
         length = rig.length(feather)
-        box = box_geometry(rig.middle(feather), np.array([thickness, chord, 0.5]) * length, axis_frame(rig.direction(feather), Z))
+        box = box_geometry(rig.middle(feather), np.array([thickness, chord, 0.5]) * length,
+                           axis_frame(rig.direction(feather), Z))
         ch.rigid(feather, box, feather, mirror=True)
     add_eyes(ch, head, "eye.L", forward=-0.4 * Y)
     return "bird"
