@@ -130,7 +130,10 @@ def both_ways(module, inputs):
         if spec.name in SKIN_NETWORKS:
             numpy_outputs = candidate_weights(NUMPY, weights, inputs, numpy_outputs)
             torch_outputs = candidate_weights(TORCH, module.params(), tensors, torch_outputs)
-    as_tuple = (lambda outputs: outputs if isinstance(outputs, tuple) else (outputs,))
+
+    def as_tuple(outputs):
+        return outputs if isinstance(outputs, tuple) else (outputs,)
+
     return as_tuple(numpy_outputs), tuple(output.numpy() for output in as_tuple(torch_outputs))
 
 
@@ -177,7 +180,8 @@ def test_a_weights_file_of_another_network_is_refused_by_name():
                                          r"input_mean, input_std, mlp\.linears\.0\.bias, mlp\.linears\.0\.weight "
                                          r"\.\.\.\)\.$"):
         RIG_NETWORKS["bones"].check_weights(weights, "root.npz")
-    with pytest.raises(InputError, match=r"skinningnet network.s weights \(missing: bone_encoder.*unexpected: input_mean"):
+    with pytest.raises(InputError, match=r"skinningnet network.s weights \(missing: bone_encoder.*"
+                                         r"unexpected: input_mean"):
         SKIN_NETWORKS["skinningnet"].check_weights(weights, "root.npz")
 
 

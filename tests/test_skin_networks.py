@@ -71,7 +71,8 @@ def test_a_missing_weights_file_is_refused_before_any_work(monkeypatch, tmp_path
     spec = SKIN_NETWORKS["skinningnet"]
     monkeypatch.setitem(SKIN_NETWORKS, "skinningnet", replace(spec, weights_file=tmp_path / "skinningnet.npz"))
     forget_shipped_weights()
-    with pytest.raises(InputError, match=r"^The trained weights of 'skinningnet' are missing .*reinstall the extension"):
+    with pytest.raises(InputError, match=r"^The trained weights of 'skinningnet' are missing "
+                                         r".*reinstall the extension"):
         predict.learned_weights(cylinder(radius=0.1, rings=6), two_bone_skeleton(), "skinningnet")
 
 

@@ -183,7 +183,8 @@ def test_sample_variants_are_normalised_stretched_and_posed():
 def test_examples_are_written_once_and_read_back(tmp_path):
     sample = procedural_sample(5)
     paths = training_set.build_examples([sample], "hollow", augment=False, folder=tmp_path)
-    assert paths == [tmp_path / f"v{training_set.EXAMPLE_FORMAT_VERSION}" / "hollow" / "seed0" / "procedural_5--rest.npz"]
+    assert paths == [tmp_path / f"v{training_set.EXAMPLE_FORMAT_VERSION}" / "hollow" / "seed0"
+                     / "procedural_5--rest.npz"]
     graph, target, reference, name = training_set.load_example(paths[0])
     expected = predict.network_graph(sample.mesh, sample.skeleton, "hollow")
     for field, array in expected.arrays().items():
@@ -203,7 +204,8 @@ def test_procedural_samples_are_normalised_characters_named_by_kind_and_seed():
     for sample in samples:
         assert sample.name == f"procedural/{sample.category}_{sample.name.split('_')[-1]}"
         extent = sample.vertices.max(axis=0) - sample.vertices.min(axis=0)
-        assert extent.max() == pytest.approx(1.0, abs=1e-9) and sample.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9)
+        assert (extent.max() == pytest.approx(1.0, abs=1e-9)
+                and sample.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9))
         np.testing.assert_allclose(sample.weights.sum(axis=1), 1.0, atol=1e-9)
 
 
