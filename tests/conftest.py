@@ -37,3 +37,19 @@ def clean_scene(registered_addon):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     yield bpy.context.scene
     bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+@pytest.fixture(autouse=True)
+def one_torch_thread(request):
+    """Tests marked ``torch`` run torch on one thread: their inputs are
+    small, and two threads on a busy 2-core machine are many times slower
+    than one. Other tests never load torch here."""
+    if request.node.get_closest_marker("torch") is None:
+        yield
+        return
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)

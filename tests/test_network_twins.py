@@ -47,16 +47,6 @@ RESOLUTION = 32
 NETWORKS = {**SKIN_NETWORKS, **RIG_NETWORKS}
 
 
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """These inputs are small: two threads on a busy 2-core machine are
-    many times slower than one."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 def trained_like(name, seed, prior_scale=0.8):
     """The network's module with seeded random parameters doubled (outputs of
     a few units, as after training; the skinning score heads, which start at

@@ -25,14 +25,6 @@ from autorig_addon.training.rigging.train import (  # noqa: E402
 from autorig_addon.training.runs import start_run, write_weights  # noqa: E402
 
 
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 @pytest.fixture(scope="module")
 def examples():
     """``(train, holdout)``: one stretched variant of two procedural

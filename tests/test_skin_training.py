@@ -43,15 +43,6 @@ TURN_MATRIX = np.array([[math.cos(TURN), -math.sin(TURN), 0.0], [math.sin(TURN),
 MIRROR_MATRIX = np.diag([-1.0, 1.0, 1.0])
 
 
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """Small graphs: one thread is much faster than two on a busy 2-core machine."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 def vector_columns(starts, width):
     """(vector columns, other columns) of a feature table ``width`` wide."""
     vectors = [column for start in starts for column in range(start, start + 3)]
