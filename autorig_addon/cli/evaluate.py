@@ -16,8 +16,10 @@ same as JSON::
 
 The methods and their registries are in :mod:`.evaluation_methods`; the
 files are picked, named and categorised by
-``core.dataset.split.collect_data``. This module parses the arguments, runs
-the method on each file and writes the report.
+``core.dataset.split.collect_data``; skin and transfer evaluation leave out
+the characters the split marks ``skeleton_only`` (their weights are not an
+artist's), saying so on stderr (:data:`TASK_PURPOSES`). This module parses
+the arguments, runs the method on each file and writes the report.
 
 The method never sees what it is judged against: a skin method gets the
 mesh and the skeleton (bone heat runs on a copy built from the arrays, with
@@ -62,7 +64,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-from ..core.dataset.split import DEFAULT_SPLIT_FILE, SUBSETS, DataItem, collect_data
+from ..core.dataset.split import DEFAULT_SPLIT_FILE, PURPOSE_SKELETON, PURPOSE_SKIN, SUBSETS, DataItem, collect_data
 from ..core.errors import InputError
 from ..core.evaluation.report import markdown_report, summarise
 from .batch import check_writable_folder, require_not_folder, stdout_to_stderr
@@ -82,6 +84,9 @@ HELP = "Score a skinning, rigging or transfer method against artist rigs"
 
 #: Task names, the first positional argument.
 TASKS = ("skin", "rig", "transfer")
+#: What each task scores against: a rig the skeleton, skin and transfer the
+#: weights, so they leave out the split's skeleton-only characters.
+TASK_PURPOSES = {"skin": PURPOSE_SKIN, "rig": PURPOSE_SKELETON, "transfer": PURPOSE_SKIN}
 
 
 # --------------------------------------------------------------------------- arguments
@@ -268,13 +273,18 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         require_not_folder(Path(args.out), "--out")
         check_writable_folder(Path(args.out).parent, "--out")
+    log = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+
+    def skipped(name: str, reason: str) -> None:
+        if log is not None:
+            log(f"{name}: left out of {args.task} evaluation (skeleton only: {reason})")
+
     try:
         check_method(args.task, args.method)
-        items = collect_data(args.data, args.split, args.split_file)
+        items = collect_data(args.data, args.split, args.split_file, TASK_PURPOSES[args.task], skipped)
         baseline = _read_baseline(args.baseline, args.task) if args.baseline else None
     except InputError as error:
         raise UsageError(str(error)) from None
-    log = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     report = evaluate(args.task, args.method, items, args.source, log)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)

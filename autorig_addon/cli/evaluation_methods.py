@@ -206,10 +206,11 @@ def _nearest_character_pool() -> tuple:
     read once per process; its validation characters are left out by name
     whatever the cache holds."""
     from ..core.dataset.cache import training_samples
-    from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
+    from ..core.dataset.split import DEFAULT_SPLIT_FILE, PURPOSE_SKELETON, read_data_split
 
     validation = {os.path.splitext(path)[0] for path in read_data_split(DEFAULT_SPLIT_FILE).validation}
-    return tuple(sample for sample in training_samples() if sample.name not in validation), frozenset(validation)
+    pool = training_samples(purpose=PURPOSE_SKELETON)
+    return tuple(sample for sample in pool if sample.name not in validation), frozenset(validation)
 
 
 def _nearest_character(mesh) -> RigPrediction:

@@ -7,7 +7,8 @@ rebuilding is reproducible. Loading the characters needs Blender
 (``blender.characters``); :func:`build_samples` takes the loader as an
 argument, so everything here works on arrays. :func:`training_samples`
 reads the cached samples of the split's training characters (training runs
-and the ``nearest_character`` baseline of ``eval rig``).
+and the ``nearest_character`` baseline of ``eval rig``), for skeletons or for
+skin weights.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from typing import Callable, Iterable, Optional
 from ..errors import InputError
 from ..progress import ProgressCallback, report
 from .sample import SAMPLE_FORMAT_VERSION, CharacterSample
-from .split import DEFAULT_SPLIT_FILE, read_data_split
+from .split import DEFAULT_SPLIT_FILE, PURPOSE_SKELETON, read_data_split
 
 #: Environment variable naming the cache root (samples go to ``<root>/samples``).
 CACHE_ENVIRONMENT_VARIABLE = "AUTORIG_CACHE"
@@ -163,9 +164,9 @@ def build_samples(
     return samples
 
 
-def training_samples(sample_dir: str | os.PathLike | None = None,
-                     split_file: Optional[str] = None) -> list[CharacterSample]:
-    """The cached samples of the split's training characters, sorted by name.
+def training_samples(sample_dir: str | os.PathLike | None = None, split_file: Optional[str] = None,
+                     purpose: str = PURPOSE_SKELETON) -> list[CharacterSample]:
+    """The cached samples of the split's training characters usable for ``purpose``, sorted by name.
 
     Parameters
     ----------
@@ -173,6 +174,11 @@ def training_samples(sample_dir: str | os.PathLike | None = None,
         Default :func:`default_cache_dir`.
     split_file : path of ``data_split.json``, optional
         Default :data:`~.split.DEFAULT_SPLIT_FILE`.
+    purpose : str
+        :data:`~.split.PURPOSE_SKELETON` (every training character: skeleton
+        training, the ``nearest_character`` baseline) or
+        :data:`~.split.PURPOSE_SKIN` (skin training: the split's
+        ``skeleton_only`` characters left out, :meth:`~.split.DataSplit.usable_for`).
 
     Raises
     ------
@@ -181,7 +187,7 @@ def training_samples(sample_dir: str | os.PathLike | None = None,
     """
     sample_dir = Path(sample_dir) if sample_dir is not None else default_cache_dir()
     split = read_data_split(split_file or DEFAULT_SPLIT_FILE)
-    wanted = {os.path.splitext(path)[0] for path in split.train}
+    wanted = {os.path.splitext(path)[0] for path in split.subset("train", purpose)}
     found = {}
     for path in sorted(sample_dir.glob("*.npz")):
         try:

@@ -3,15 +3,19 @@
 :func:`read_data_split` reads the split, :func:`relative_name` and
 :func:`category_of` name and categorise a file, and :func:`collect_data`
 picks the files of given files and folders that a subset of the split lists.
+What a character may be used for is decided in one place,
+:meth:`DataSplit.usable_for`: every character serves skeletons, and those the
+split marks ``skeleton_only`` (weights that are not an artist's skinning)
+are left out of skin training and skin evaluation.
 """
 
 from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 from ..errors import InputError
 from ..io.scene_formats import scene_files
@@ -19,6 +23,14 @@ from ..io.scene_formats import scene_files
 #: Names of the subsets of a split: all its files, the training files and the
 #: validation files.
 SUBSETS = ("all", "train", "validation")
+#: What a character is used for: its skeleton (every character of the split)
+#: or its skin weights (not the split's ``skeleton_only`` characters).
+PURPOSE_SKELETON = "skeleton"
+PURPOSE_SKIN = "skin"
+PURPOSES = (PURPOSE_SKELETON, PURPOSE_SKIN)
+#: Kinds of character the split's ``categories`` name.
+HUMANOID, QUADRUPED, BIRD, FISH, OTHER = "humanoid", "quadruped", "bird", "fish", "other"
+KINDS = (HUMANOID, QUADRUPED, BIRD, FISH, OTHER)
 #: Where the train/validation split lives: the repository's top folder.
 DEFAULT_SPLIT_FILE = Path(__file__).resolve().parents[3] / "data_split.json"
 
@@ -32,28 +44,43 @@ class DataSplit:
     train, validation : tuple of str
         File paths relative to the characters folder, ``/``-separated.
     categories : dict of str -> str
-        Category of each listed path.
+        Category (kind) of each listed path.
+    skeleton_only : dict of str -> str
+        Paths whose skin weights are not trusted, with the reason: used for
+        skeletons, never for skin weights (:meth:`usable_for`).
     """
 
     train: tuple
     validation: tuple
     categories: dict
+    skeleton_only: dict = field(default_factory=dict)
 
-    def subset(self, name: str) -> tuple:
-        """Paths of ``"train"``, ``"validation"`` or ``"all"``."""
+    def usable_for(self, path: str, purpose: str) -> bool:
+        """Whether the character at ``path`` (relative, as listed) may be used
+        for ``purpose`` (:data:`PURPOSES`): any character for skeletons, not a
+        ``skeleton_only`` one for skin weights."""
+        if purpose not in PURPOSES:
+            raise InputError(f"Unknown purpose {purpose!r}: use {' or '.join(PURPOSES)}.")
+        return purpose == PURPOSE_SKELETON or path not in self.skeleton_only
+
+    def subset(self, name: str, purpose: str = PURPOSE_SKELETON) -> tuple:
+        """Paths of ``"train"``, ``"validation"`` or ``"all"`` usable for ``purpose``."""
         if name == "train":
-            return self.train
-        if name == "validation":
-            return self.validation
-        if name == "all":
-            return tuple(dict.fromkeys(self.train + self.validation))
-        raise InputError(f"Unknown split {name!r}: use train, validation or all.")
+            paths = self.train
+        elif name == "validation":
+            paths = self.validation
+        elif name == "all":
+            paths = tuple(dict.fromkeys(self.train + self.validation))
+        else:
+            raise InputError(f"Unknown split {name!r}: use train, validation or all.")
+        return tuple(path for path in paths if self.usable_for(path, purpose))
 
 
 def read_data_split(path: str | os.PathLike) -> DataSplit:
     """Read ``data_split.json``.
 
-    Accepts ``categories`` as ``{path: category}`` or ``{category: [paths]}``.
+    Accepts ``categories`` as ``{path: category}`` or ``{category: [paths]}``;
+    ``skeleton_only`` (``{path: reason}``) is optional.
 
     Raises
     ------
@@ -70,7 +97,11 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
         raise InputError(f"'{path.name}' must be a JSON object with 'train' and 'validation' lists of paths.")
     train = tuple(_split_path(entry) for entry in document["train"])
     validation = tuple(_split_path(entry) for entry in document["validation"])
-    return DataSplit(train, validation, _categories(document.get("categories", {})))
+    skeleton_only = document.get("skeleton_only", {})
+    if not isinstance(skeleton_only, dict):
+        raise InputError(f"'{path.name}': 'skeleton_only' must map paths to the reason their weights are not used.")
+    return DataSplit(train, validation, _categories(document.get("categories", {})),
+                     {_split_path(key): str(reason) for key, reason in skeleton_only.items()})
 
 
 def _split_path(entry) -> str:
@@ -127,7 +158,9 @@ class DataItem:
     category: str
 
 
-def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None) -> list[DataItem]:
+def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None,
+                 purpose: str = PURPOSE_SKELETON,
+                 skipped: Optional[Callable[[str, str], None]] = None) -> list[DataItem]:
     """Files to evaluate, named and categorised.
 
     A folder contributes every loadable file below it, named by its path
@@ -136,6 +169,8 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     file are kept (matched by the end of their path, since the split holds
     paths relative to the characters folder). Categories come from the
     split when it lists the file, else from the folder holding the file.
+    Files the split says are not usable for ``purpose``
+    (:meth:`DataSplit.usable_for`) are left out whatever the subset.
 
     Parameters
     ----------
@@ -145,6 +180,11 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
         One of :data:`SUBSETS`.
     split_file : str, optional
         The split; default :data:`DEFAULT_SPLIT_FILE`.
+    purpose : str
+        :data:`PURPOSE_SKELETON` (rig evaluation) or :data:`PURPOSE_SKIN`
+        (skin and transfer evaluation, which score against the weights).
+    skipped : callable(name, reason), optional
+        Told about each file left out for ``purpose``.
 
     Returns
     -------
@@ -178,6 +218,10 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
         for path, name in zip(files, names):
             entry = _split_entry(path, split)
             if split_name != "all" and entry not in wanted:
+                continue
+            if entry is not None and not split.usable_for(entry, purpose):
+                if skipped is not None:
+                    skipped(name, split.skeleton_only[entry])
                 continue
             category = category_of(entry, split) if entry is not None else path.parent.name
             items.append(DataItem(path, name, category or "uncategorised"))

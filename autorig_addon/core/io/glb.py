@@ -1,7 +1,8 @@
-"""Binary and text glTF files rewritten without their animations.
+"""Binary and text glTF files read, and rewritten without their animations.
 
-The glTF importer poses a skeleton at frame 0 of the first clip; a copy
-without ``animations`` imports in the file's default pose (the joints' node
+:func:`read_glb` gives a binary file's JSON document and binary chunk. The
+glTF importer poses a skeleton at frame 0 of the first clip; a copy without
+``animations`` imports in the file's default pose (the joints' node
 transforms), which the bind-pose check compares with the rest pose. Plain
 JSON and bytes, no Blender.
 """
@@ -25,21 +26,47 @@ GLB_HEADER = struct.Struct("<III")
 GLB_CHUNK_HEADER = struct.Struct("<II")
 
 
+#: Chunk type of the binary buffer chunk ("BIN").
+GLB_BINARY_CHUNK = 0x004E4942
+
+
+def _glb_json(data: bytes, name: str) -> tuple[dict, int]:
+    """The JSON document of a binary glTF file's bytes and where its JSON chunk ends."""
+    if len(data) < GLB_HEADER.size + GLB_CHUNK_HEADER.size:
+        raise InputError(f"'{name}' is not a binary glTF file (too short).")
+    magic, _, _ = GLB_HEADER.unpack_from(data, 0)
+    if magic != GLB_MAGIC:
+        raise InputError(f"'{name}' is not a binary glTF file (bad magic number).")
+    json_length, json_type = GLB_CHUNK_HEADER.unpack_from(data, GLB_HEADER.size)
+    if json_type != GLB_JSON_CHUNK:
+        raise InputError(f"'{name}' does not start with a JSON chunk.")
+    json_start = GLB_HEADER.size + GLB_CHUNK_HEADER.size
+    document = json.loads(data[json_start:json_start + json_length].decode("utf-8"))
+    return document, json_start + json_length
+
+
+def read_glb(path: Path) -> tuple[dict, bytes]:
+    """The JSON document and the binary chunk (``b""`` when there is none) of a binary glTF file."""
+    data = Path(path).read_bytes()
+    document, json_end = _glb_json(data, Path(path).name)
+    binary = b""
+    if len(data) >= json_end + GLB_CHUNK_HEADER.size:
+        length, kind = GLB_CHUNK_HEADER.unpack_from(data, json_end)
+        if kind == GLB_BINARY_CHUNK:
+            start = json_end + GLB_CHUNK_HEADER.size
+            binary = data[start:start + length]
+    return document, binary
+
+
 def glb_without_animations(source: Path, target: Path) -> None:
     """Copy the binary glTF ``source`` to ``target`` without its ``animations``."""
     data = source.read_bytes()
-    magic, version, _ = GLB_HEADER.unpack_from(data, 0)
-    if magic != GLB_MAGIC:
-        raise InputError(f"'{source.name}' is not a binary glTF file (bad magic number).")
-    json_length, json_type = GLB_CHUNK_HEADER.unpack_from(data, GLB_HEADER.size)
-    if json_type != GLB_JSON_CHUNK:
-        raise InputError(f"'{source.name}' does not start with a JSON chunk.")
-    json_start = GLB_HEADER.size + GLB_CHUNK_HEADER.size
-    document = json.loads(data[json_start:json_start + json_length].decode("utf-8"))
+    document, json_end = _glb_json(data, source.name)
+    _, version, _ = GLB_HEADER.unpack_from(data, 0)
     document.pop("animations", None)
     text = json.dumps(document).encode("utf-8")
     text += b" " * (-len(text) % 4)
-    rest = data[json_start + json_length:]
+    rest = data[json_end:]
     total = GLB_HEADER.size + GLB_CHUNK_HEADER.size + len(text) + len(rest)
     target.write_bytes(
         GLB_HEADER.pack(GLB_MAGIC, version, total) + GLB_CHUNK_HEADER.pack(len(text), GLB_JSON_CHUNK) + text + rest

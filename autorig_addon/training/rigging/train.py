@@ -32,6 +32,7 @@ import numpy as np
 import torch
 
 from ...core.dataset.cache import default_cache_dir, training_samples
+from ...core.dataset.split import PURPOSE_SKELETON
 from ...core.evaluation.skeleton_metrics import chamfer_j2j
 from ...core.nn.spec import NetworkSpec
 from ...core.rigging.connectivity import bone_probabilities, root_scores
@@ -199,7 +200,7 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
                        score_name="cd_j2j" if network == "joints" else "cross_entropy")
     folder = Path(examples_dir or default_examples_dir(seed))
-    examples = build_examples(training_samples(Path(sample_dir)), folder, seed)
+    examples = build_examples(training_samples(Path(sample_dir), purpose=PURPOSE_SKELETON), folder, seed)
     names = sorted(examples)
     held_names = held_out_names(names)
     made = build_examples(procedural_samples(procedural), folder, seed)

@@ -27,6 +27,7 @@ import numpy as np
 import torch
 
 from ....core.dataset.cache import training_samples
+from ....core.dataset.split import PURPOSE_SKIN
 from ....core.evaluation.skin_metrics import influence_precision_recall, skin_l1
 from ....core.skinning.geometric import DEFAULT_MAX_INFLUENCES
 from ....core.skinning.learned.features import BONE_VECTORS, PAIR_VECTORS, VERTEX_VECTORS, SkinGraph
@@ -121,7 +122,7 @@ def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path]
     spec = skin_network(network)
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
                        score_name=SCORE_NAME)
-    samples = training_samples(sample_dir, split_file)
+    samples = training_samples(sample_dir, split_file, PURPOSE_SKIN)
     held_names = held_out_names([sample.name for sample in samples])
     samples = samples + procedural_samples(procedural)  # never held out: the epoch is chosen on artists' rigs
     train, holdout = [], []
