@@ -88,6 +88,45 @@ def small_humanoid() -> Skeleton:
     return Skeleton(np.asarray(joints), parents, tuple(f"j{k}" for k in range(len(parents))))
 
 
+def arm_posed_humanoid(left_degrees: float, right_degrees: float, prefix: str = "mixamorig:") -> Skeleton:
+    """A 1.7-high humanoid with Mixamo's bone names (after ``prefix``) whose
+    arms hang the given angles below the horizontal, straight from the upper
+    arm to the index finger's tip; hips at z = 1, feet on the ground, facing -Y."""
+    joints, parents, names = [], [], []
+
+    def add(name: str, point, parent: int) -> int:
+        joints.append(point)
+        parents.append(parent)
+        names.append(prefix + name)
+        return len(joints) - 1
+
+    hips = add("Hips", [0.0, 0.0, 1.0], -1)
+    spine = add("Spine", [0.0, 0.0, 1.2], hips)
+    chest = add("Spine2", [0.0, 0.0, 1.4], spine)
+    add("Head", [0.0, 0.0, 1.55], add("Neck", [0.0, 0.0, 1.5], chest))
+    for side, sign, degrees in (("Left", 1.0, left_degrees), ("Right", -1.0, right_degrees)):
+        shoulder = add(f"{side}Shoulder", [sign * 0.05, 0.0, 1.45], chest)
+        start = np.array([sign * 0.15, 0.0, 1.45])
+        along = np.array([sign * np.cos(np.radians(degrees)), 0.0, -np.sin(np.radians(degrees))])
+        joint = add(f"{side}Arm", start, shoulder)
+        for name, reach in (("ForeArm", 0.28), ("Hand", 0.52), ("HandIndex1", 0.6), ("HandIndex2", 0.64)):
+            joint = add(f"{side}{name}", start + reach * along, joint)
+        knee = add(f"{side}Leg", [sign * 0.1, 0.0, 0.5], add(f"{side}UpLeg", [sign * 0.1, 0.0, 0.95], hips))
+        add(f"{side}ToeBase", [sign * 0.1, -0.12, 0.0], add(f"{side}Foot", [sign * 0.1, 0.0, 0.08], knee))
+    return Skeleton(np.asarray(joints), parents, tuple(names))
+
+
+def points_along_bones(skeleton: Skeleton, per_bone: int = 12, offset: float = 0.01) -> tuple[Mesh, np.ndarray]:
+    """A point cloud of ``per_bone`` points along each bone, ``offset`` off
+    its axis, as a Mesh (one triangle) and the (n,) bone index of each point."""
+    points, owners = [], []
+    for bone, (head, tail) in enumerate(zip(skeleton.joints, skeleton.tails)):
+        for t in np.linspace(0.1, 0.9, per_bone):
+            points.append(head + t * (tail - head) + [offset, offset, 0.0])
+            owners.append(bone)
+    return Mesh(np.asarray(points), [[0, 1, 2]]), np.asarray(owners)
+
+
 def box_mesh(low, high, spacing: float) -> Mesh:
     """Closed axis-aligned box whose faces are grids of about ``spacing``,
     outward normals (faces are not welded to each other; the surface is

@@ -13,7 +13,7 @@ from autorig_addon.blender import bind_pose, bone_heat, characters, scene_io, si
 from autorig_addon.core import dataset
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.geometry.weld import weld_seams
-from autorig_addon.core.types import Mesh
+from autorig_addon.core.types import Mesh, Skeleton, Weights
 from blender_fixtures import (
     BODY_HEIGHT,
     BODY_RADIUS,
@@ -28,6 +28,7 @@ from blender_fixtures import (
     mesh_object,
     reset_scene,
 )
+from geometry_fixtures import arm_posed_humanoid, points_along_bones
 
 #: Bounding-box diagonal of the body cylinder (0.6 x 0.6 x 2).
 BODY_SIZE = math.sqrt((2 * BODY_RADIUS) ** 2 * 2 + BODY_HEIGHT ** 2)
@@ -263,3 +264,27 @@ def test_character_samples_are_cached(clean_scene, tmp_path, monkeypatch):
                                                 split=split)[0]
     np.testing.assert_array_equal(first.vertices, second.vertices)
     np.testing.assert_array_equal(first.weights, second.weights)
+
+
+def test_loader_notes_rigid_weights_the_mixamo_check_and_a_humanoids_rest_pose():
+    skeleton = arm_posed_humanoid(70.0, 70.0)
+    mesh, owners = points_along_bones(skeleton)
+    weights = Weights(np.eye(len(skeleton.names))[owners], skeleton.names)
+    humanoid = characters.RiggedCharacter("guy", "guy.glb", mesh, skeleton, weights, category=dataset.HUMANOID)
+    notes = characters.weight_and_pose_notes(humanoid)
+    assert notes[0] == "rigid weights: every weighted vertex follows one bone"
+    assert notes[1].startswith("weights checked against the bone names: plausible (0 of 300 vertices unweighted;")
+    assert notes[2] == "rest pose: arms down (arms 70 and 70 degrees below horizontal, left and right)"
+    # Blended weights, no Mixamo names, and not a humanoid: nothing to say.
+    blended = Weights(0.5 * np.eye(len(skeleton.names))[owners] + 0.5 * np.eye(len(skeleton.names))[0],
+                      skeleton.names)
+    plain_names = tuple(name.replace("mixamorig:", "") for name in skeleton.names)
+    plain = Skeleton(skeleton.joints, skeleton.parents, plain_names)
+    animal = characters.RiggedCharacter("cat", "cat.glb", mesh, plain, Weights(blended.matrix, plain.names),
+                                        category="quadruped")
+    assert characters.weight_and_pose_notes(animal) == []
+    # A humanoid whose arms the names do not tell says so.
+    anonymous = Skeleton(skeleton.joints, skeleton.parents, tuple(f"bone_{k}" for k in range(len(skeleton.names))))
+    faceless = characters.RiggedCharacter("x", "x.glb", mesh, anonymous, Weights(blended.matrix, anonymous.names),
+                                          category=dataset.HUMANOID)
+    assert characters.weight_and_pose_notes(faceless) == ["rest pose: no left and right arm found by name"]

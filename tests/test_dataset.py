@@ -20,7 +20,9 @@ from autorig_addon.core.dataset.normalise import (
     FACING_UNKNOWN,
     apply_transform,
     bone_side,
+    facing_decision,
     facing_quarter_turns,
+    head_tail_quarter_turns,
     normalise,
 )
 from autorig_addon.core.dataset.sample import SAMPLE_FORMAT_VERSION, CharacterSample
@@ -58,6 +60,10 @@ def biped(facing_plus_y: bool) -> tuple:
         ("UpperArm.L", 1), ("hand.r", -1), ("Foot_L", 1), ("toe_r", -1), ("L_Hand", 1), ("r.leg", -1),
         ("mixamorig:LeftArm", 1), ("B_Knee_Right", -1), ("Spine", 0), ("Tail", 0), ("Lower", 0), ("Root", 0),
         ("LeftRight", 0),
+        # A lone letter between separators (Character Studio's Biped, Red Eclipse's twist bones).
+        ("bip01 l hand", 1), ("bip01 r calf", -1), ("thigh.L.01", 1), ("finger_index.01.R.02", -1),
+        # A word outranks a letter: 0 A.D.'s giraffe names its rear legs left_r_ and right_r_.
+        ("left_r_leg_top", 1), ("right_f_foot", -1), ("Bovidae_FrontCalf_left", 1),
     ],
 )
 def test_bone_side_from_names(name, side):
@@ -114,6 +120,81 @@ def test_normalise_keeps_orientation_when_names_say_nothing():
     assert result.transform[0, 0] > 0
 
 
+def quadruped(left_x: float, deform_sides: bool = True) -> Skeleton:
+    """A four-legged animal 2 long along y with its head at -Y (facing -Y) and
+    its tail at +Y; its legs named .L lie at x = ``left_x`` (+0.3 is Blender's
+    convention, -0.3 a mirrored naming)."""
+    joints = [[0, 0, 1], [0, -0.9, 1.3], [0, 1.0, 1.0],
+              [left_x, -0.7, 0.9], [left_x, -0.7, 0.0], [-left_x, -0.7, 0.9], [-left_x, -0.7, 0.0],
+              [left_x, 0.7, 0.9], [left_x, 0.7, 0.0], [-left_x, 0.7, 0.9], [-left_x, 0.7, 0.0]]
+    names = ("spine", "head", "tail", "front_leg.L", "front_foot.L", "front_leg.R", "front_foot.R",
+             "hind_leg.L", "hind_foot.L", "hind_leg.R", "hind_foot.R")
+    return Skeleton(joints, [-1, 0, 0, 0, 3, 0, 5, 0, 7, 0, 9], names, deform=[True] * 11 if deform_sides else None)
+
+
+def turned_about_z(skeleton: Skeleton, degrees: float) -> Skeleton:
+    angle = np.radians(degrees)
+    turn = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    return Skeleton(skeleton.joints @ turn.T, skeleton.parents, skeleton.names, skeleton.tails @ turn.T,
+                    skeleton.deform)
+
+
+def test_the_head_ahead_of_the_tail_outranks_mirrored_side_names():
+    # 0 A.D.'s cattle face -Y with their .L legs at -X: the names alone would turn them half around.
+    mirrored = quadruped(left_x=-0.3)
+    assert facing_quarter_turns(mirrored) == 2 and head_tail_quarter_turns(mirrored) == 0
+    decision = facing_decision(mirrored)
+    assert decision.quarter_turns == 0 and decision.facing == FACING_AS_NAMED
+    assert decision.note == ("faces -Y as loaded (head ahead of tail; its side names would have turned it half a "
+                             "turn, so they are mirrored or not lateral)")
+    # Names and head agree: the names say it.
+    assert facing_decision(quadruped(left_x=0.3)).note == "faces -Y as loaded (side names: left joints at +X)"
+
+
+def test_the_head_ahead_of_the_tail_turns_an_animal_without_side_names():
+    plain = quadruped(left_x=0.3)
+    anonymous = Skeleton(plain.joints, plain.parents, ("spine", "head", "tail") + tuple(f"leg{k}" for k in range(8)))
+    facing_plus_x = turned_about_z(anonymous, 90.0)  # head at +X
+    assert facing_quarter_turns(facing_plus_x) is None and head_tail_quarter_turns(facing_plus_x) == 3
+    decision = facing_decision(facing_plus_x)
+    assert (decision.quarter_turns, decision.facing) == (3, FACING_TURNED)
+    assert decision.note == "turned a quarter turn clockwise to face -Y (head ahead of tail; no side names)"
+    # A head above its tail, not ahead of it (a biped with a hanging tail), says nothing.
+    upright = Skeleton([[0, 0, 1.0], [0, 0.05, 1.8], [0, 0.1, 0.9]], [-1, 0, 0], ("hips", "head", "tail"))
+    assert head_tail_quarter_turns(upright) is None
+    assert facing_decision(upright).note == "facing kept as loaded: no side names, no head ahead of a tail"
+
+
+def test_facing_reads_deform_bones_near_the_body():
+    # Facing -Y (left at +X) with a stance: the left hand and its fingers reach across to -X,
+    # and weightless IK targets named for each side sit on the wrong side.
+    joints = [[0, 0, 1.0], [0, 0, 1.5], [0.1, 0, 1.5], [0.25, 0, 1.5], [0.1, -0.3, 1.3], [-0.5, -0.4, 1.3],
+              [-0.6, -0.4, 1.3], [-0.7, -0.4, 1.3], [-0.8, -0.4, 1.3], [-0.1, 0, 1.5], [-0.25, 0, 1.5],
+              [-0.3, -0.1, 1.2], [-0.35, -0.1, 1.0], [-2.0, 0, 0], [2.0, 0, 0]]
+    names = ("hips", "chest", "clavicle.L", "upper_arm.L", "forearm.L", "hand.L", "finger.L", "finger.001.L",
+             "finger.002.L", "clavicle.R", "upper_arm.R", "forearm.R", "hand.R", "ik_hand.L", "ik_hand.R")
+    parents = [-1, 0, 1, 2, 3, 4, 5, 6, 7, 1, 9, 10, 11, 0, 0]
+    stance = Skeleton(joints, parents, names, deform=[True] * 13 + [False, False])
+    assert facing_quarter_turns(stance) == 0
+    # Every side-named joint counted alike, the hand and the IK targets would turn it half around.
+    everything = np.array([bone_side(name) for name in names])
+    points = np.asarray(joints)
+    assert points[everything == 1, 0].mean() < points[everything == -1, 0].mean()
+
+
+def test_facing_notes_a_body_turned_off_the_axes():
+    decision = facing_decision(turned_about_z(quadruped(left_x=0.3), 30.0))
+    assert decision.quarter_turns == 0
+    assert decision.note == ("faces -Y as loaded (side names: left joints at +X; the left-right line is 30 degrees "
+                             "off that axis)")
+
+
+def test_normalise_notes_its_scale_and_facing():
+    mesh, skeleton = biped(facing_plus_y=False)
+    assert normalise(mesh, skeleton).notes == ("scaled by 1/1.8: the largest side is z, 1.8 file units (height 1.8)",
+                                               "faces -Y as loaded (side names: left joints at +X)")
+
+
 def test_normalise_rejects_meshes_without_extent():
     skeleton = Skeleton([[0.0, 0.0, 0.0]], [-1], ("Root",))
     with pytest.raises(InputError, match="The mesh has no vertices, so it cannot be normalised"):
@@ -141,6 +222,9 @@ def test_long_animals_are_scaled_by_their_longest_side():
 
 #: Loader notes as ``blender.characters`` writes them (one on the bone tails).
 NOTES = ("bone tails derived from the joints: the stored ones are point-like", "12 of 120 vertices have no weight")
+#: What the normalisation notes about the biped of :func:`make_sample` (1.8 tall, facing +Y).
+NORMALISATION_NOTES = ("scaled by 1/1.8: the largest side is z, 1.8 file units (height 1.8)",
+                       "turned half a turn to face -Y (side names: left joints at +X)")
 
 
 def make_sample(name="Guy", category="biped", notes=NOTES):
@@ -164,7 +248,7 @@ def test_sample_round_trip(tmp_path):
         np.testing.assert_array_equal(getattr(loaded, key), getattr(sample, key))
     assert loaded.names == sample.names and loaded.name == "Guy" and loaded.category == "biped"
     assert loaded.facing == FACING_TURNED and loaded.source_vertex_count == mesh.vertex_count
-    assert loaded.notes == NOTES
+    assert loaded.notes == NOTES + NORMALISATION_NOTES
     # The stored transform takes the original mesh onto the stored vertices.
     np.testing.assert_allclose(apply_transform(mesh.vertices, loaded.transform), loaded.vertices, atol=1e-12)
     assert loaded.skin.bone_names == ("Hips", "Chest", "UpperArm.L", "UpperArm.R")
@@ -173,21 +257,22 @@ def test_sample_round_trip(tmp_path):
 def test_sample_without_notes_round_trips(tmp_path):
     sample, _, _ = make_sample(notes=())
     sample.save(tmp_path / "quiet.npz")
-    assert CharacterSample.load(tmp_path / "quiet.npz").notes == ()
+    assert CharacterSample.load(tmp_path / "quiet.npz").notes == NORMALISATION_NOTES
 
 
 def test_loading_another_format_version_is_an_input_error(tmp_path):
-    # Format 2: samples of format 1 (before glTF bone tails were derived from
-    # the joints, and without notes) must be rebuilt.
-    assert SAMPLE_FORMAT_VERSION == 2
+    # Format 3: samples of format 2 (before the facing read the deform bones
+    # near the body and the head ahead of the tail, and without the
+    # normalisation's and the rest pose's notes) must be rebuilt.
+    assert SAMPLE_FORMAT_VERSION == 3
     sample, _, _ = make_sample()
     path = tmp_path / "old.npz"
     sample.save(path)
     with np.load(path) as data:
         arrays = dict(data)
-    arrays["format_version"] = np.int64(1)
+    arrays["format_version"] = np.int64(2)
     np.savez(path, **arrays)
-    with pytest.raises(InputError, match="'old.npz' is a sample of format 1, this version reads 2: delete it"):
+    with pytest.raises(InputError, match="'old.npz' is a sample of format 2, this version reads 3: delete it"):
         CharacterSample.load(path)
     with pytest.raises(InputError, match="The sample file '.*missing.npz' does not exist"):
         CharacterSample.load(tmp_path / "missing.npz")
@@ -230,7 +315,7 @@ def test_build_samples_caches_and_reuses(tmp_path):
         np.testing.assert_array_equal(built.vertices, cached.vertices)
         np.testing.assert_array_equal(built.weights, cached.weights)
         assert built.name == cached.name
-        assert built.notes == cached.notes == NOTES
+        assert built.notes == cached.notes == NOTES + NORMALISATION_NOTES
     # Other parameters or changed content make new samples.
     build_samples(paths, loader, tmp_path / "cache", target_vertices=1000)
     assert len(loader.calls) == 4

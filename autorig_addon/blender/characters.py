@@ -24,10 +24,12 @@ import bpy
 import numpy as np
 
 from ..core import dataset
+from ..core.dataset.weight_checks import check_named_weights, has_mixamo_names
 from ..core.errors import InputError
 from ..core.geometry.bounding_box import character_size
 from ..core.messages import listed_names
 from ..core.progress import ProgressCallback
+from ..core.skeleton.rest_pose import arm_pose
 from ..core.skeleton.tails import with_reliable_tails
 from ..core.types import Mesh, Skeleton, Weights
 from ..core.weights import INFLUENCE_EPSILON, normalize_rows
@@ -176,7 +178,8 @@ def read_character(name: str, path: str = "", category: str = "") -> RiggedChara
         )
     idle = [bone for bone, used in zip(deforming, carries_weight) if not used]
     if idle:
-        notes.append(f"{len(idle)} deform bones carry no weight and are treated as non-deform: {listed_names(idle)}")
+        notes.append(f"{len(idle)} deform bones carry no weight and are treated as non-deform (left out of the "
+                     f"skeleton targets): {listed_names(idle)}")
     weighted_bones = set(bone for bone, used in zip(deforming, carries_weight) if used)
     deform = np.array([bone in weighted_bones for bone in full_skeleton.names], dtype=bool)
     skeleton, tail_decision = with_reliable_tails(replace(full_skeleton, deform=deform), character_size(mesh.vertices))
@@ -191,7 +194,26 @@ def read_character(name: str, path: str = "", category: str = "") -> RiggedChara
     )
     if character.unweighted_count:
         notes.append(f"{character.unweighted_count} of {mesh.vertex_count} vertices have no weight")
+    notes.extend(weight_and_pose_notes(character))
     return replace(character, notes=tuple(notes))
+
+
+def weight_and_pose_notes(character: RiggedCharacter) -> list[str]:
+    """What the loader finds about a character's weights and rest pose:
+    rigid weights (every weighted vertex on one bone), the Mixamo-name
+    weight check (``core.dataset.weight_checks``) for rigs with Mixamo's
+    names, and the arms' rest pose (``core.skeleton.rest_pose``) of a
+    humanoid (its category, the split's kind)."""
+    notes = []
+    influences = (character.weights.matrix > INFLUENCE_EPSILON).sum(axis=1)
+    if influences.max(initial=0) == 1:
+        notes.append("rigid weights: every weighted vertex follows one bone")
+    if has_mixamo_names(character.skeleton.names):
+        notes.append(check_named_weights(character.mesh, character.skeleton, character.weights).note)
+    if character.category == dataset.HUMANOID:
+        pose = arm_pose(character.skeleton)
+        notes.append(pose.note if pose is not None else "rest pose: no left and right arm found by name")
+    return notes
 
 
 def load_character(path: str | os.PathLike, name: Optional[str] = None, category: str = "") -> RiggedCharacter:

@@ -16,7 +16,12 @@ from .normalise import FACING_UNKNOWN, normalise
 #: Bumped whenever the sample content or normalisation changes, so old cache
 #: files are not reused. 2: bone tails of glTF files derived from the joints
 #: when the stored ones are point-like, and the loader's notes kept.
-SAMPLE_FORMAT_VERSION = 2
+#: 3: facing read from the deform bones near the body (lone side letters such
+#: as ``bip01 l hand`` understood) and from the head ahead of the tail when the
+#: side names disagree; the normalisation's scale and facing, the rest pose,
+#: rigid weights and the Mixamo-name weight check noted; ``category`` is the
+#: split's kind (humanoid, quadruped, bird, fish, other).
+SAMPLE_FORMAT_VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -36,7 +41,8 @@ class CharacterSample:
         Columns are the ``d`` deform bones in joint order; rows sum to one
         (rows of vertices the artist left unweighted are zero).
     name : str, the character's name
-    category : str, e.g. ``"biped"`` or the source folder
+    category : str, the split's kind (``"humanoid"``, ``"quadruped"``, ...),
+        a procedural kind, or the source folder
     transform : (4, 4) float64 array
         From the source file's world space to the normalised frame (see
         :func:`~.normalise.normalise`); its inverse maps predictions back.
@@ -45,7 +51,9 @@ class CharacterSample:
     notes : tuple of str
         What the loader chose or changed and why (which armature, meshes
         left out, bone tails derived from the joints, unweighted
-        vertices, ...), as ``blender.characters.RiggedCharacter.notes``.
+        vertices, rigid weights, the rest pose, ...), as
+        ``blender.characters.RiggedCharacter.notes``, then what the
+        normalisation did (the scale, and the facing with its cue).
     """
 
     vertices: np.ndarray
@@ -97,7 +105,8 @@ class CharacterSample:
         skeleton : Skeleton, world space
         weights : Weights (n, b), matched to the deform bones by name
         source_vertex_count : int, vertices before any simplification
-        notes : tuple of str, the loader's notes, kept as they are
+        notes : tuple of str, the loader's notes, kept as they are; the
+            normalisation's own (:attr:`.normalise.Normalised.notes`) follow
         """
         if weights.vertex_count != mesh.vertex_count:
             raise InputError(
@@ -120,7 +129,7 @@ class CharacterSample:
             transform=normalised.transform,
             facing=normalised.facing,
             source_vertex_count=int(source_vertex_count or mesh.vertex_count),
-            notes=tuple(notes),
+            notes=tuple(notes) + normalised.notes,
         )
 
     def save(self, path: str | os.PathLike) -> None:
