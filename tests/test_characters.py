@@ -288,3 +288,23 @@ def test_loader_notes_rigid_weights_the_mixamo_check_and_a_humanoids_rest_pose()
     faceless = characters.RiggedCharacter("x", "x.glb", mesh, anonymous, Weights(blended.matrix, anonymous.names),
                                           category=dataset.HUMANOID)
     assert characters.weight_and_pose_notes(faceless) == ["rest pose: no left and right arm found by name"]
+
+
+def test_train_samples_builds_every_split_character_and_reports_failures(clean_scene, tmp_path, capsys):
+    from autorig_addon.training.command import _build_samples
+
+    characters_folder = tmp_path / "characters"
+    (characters_folder / "pack").mkdir(parents=True)
+    save_rig(characters_folder / "pack" / "guy.glb")
+    (characters_folder / "pack" / "broken.glb").write_bytes(b"not a glTF file")
+    split_file = tmp_path / "split.json"
+    split_file.write_text(json.dumps({"train": ["pack/guy.glb"], "validation": ["pack/broken.glb"],
+                                      "excluded": {"pack/odd.glb": "its mesh is broken"}}))
+    failed = _build_samples(characters_folder, tmp_path / "samples", split_file)
+    assert failed == 1
+    assert len(list((tmp_path / "samples").glob("guy-*.npz"))) == 1
+    lines = capsys.readouterr().err.splitlines()
+    assert any(line.startswith("[1/2] pack/guy.glb: ") and line.endswith(" vertices, unknown") for line in lines)
+    assert any(line.startswith("[2/2] pack/broken.glb: FAILED: Error: Bad glTF: json error") for line in lines)
+    assert any(line.startswith("1 samples in ") and line.endswith("1 failed; 1 files left out by the split "
+                                                                  "(data_split.json 'excluded')") for line in lines)

@@ -197,6 +197,7 @@ SPLIT = {
     "validation": ["bots/rigid_val.glb", "people/val.glb"],
     "categories": {"humanoid": ["bots/rigid.glb", "people/painted.glb", "bots/rigid_val.glb", "people/val.glb"]},
     "skeleton_only": {"bots/rigid.glb": "rigid weights", "bots/rigid_val.glb": "rigid weights"},
+    "excluded": {"people/broken.glb": "a mesh part far off the body"},
 }
 
 
@@ -204,6 +205,8 @@ def test_skeleton_only_characters_serve_skeletons_and_never_skin_weights(tmp_pat
     (tmp_path / "split.json").write_text(json.dumps(SPLIT))
     split = read_data_split(tmp_path / "split.json")
     assert split.skeleton_only == {"bots/rigid.glb": "rigid weights", "bots/rigid_val.glb": "rigid weights"}
+    assert split.excluded == {"people/broken.glb": "a mesh part far off the body"}
+    assert "people/broken.glb" not in split.subset("all")
     assert split.usable_for("bots/rigid.glb", PURPOSE_SKELETON) and not split.usable_for("bots/rigid.glb", PURPOSE_SKIN)
     assert split.subset("train", PURPOSE_SKIN) == ("people/painted.glb",)
     assert split.subset("train") == split.subset("train", PURPOSE_SKELETON) == ("bots/rigid.glb", "people/painted.glb")
@@ -211,7 +214,7 @@ def test_skeleton_only_characters_serve_skeletons_and_never_skin_weights(tmp_pat
     with pytest.raises(InputError, match="Unknown purpose 'colour': use skeleton or skin"):
         split.usable_for("people/val.glb", "colour")
     (tmp_path / "bad.json").write_text(json.dumps({**SPLIT, "skeleton_only": ["bots/rigid.glb"]}))
-    with pytest.raises(InputError, match="'skeleton_only' must map paths to the reason"):
+    with pytest.raises(InputError, match="'skeleton_only' must map paths to the reason their weights are not used"):
         read_data_split(tmp_path / "bad.json")
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import time
 from pathlib import Path
 
 from ..core.dataset.cache import default_cache_dir
@@ -67,12 +68,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     # The command line imports this module while it starts, so its own
     # modules are imported when the command runs.
-    from ..cli.exit_codes import EXIT_OK, UsageError
+    from ..cli.exit_codes import EXIT_FAILED, EXIT_OK, UsageError
 
     samples = args.samples or default_cache_dir()
     if args.what == "samples":
-        _build_samples(args.characters, samples)
-        return EXIT_OK
+        return EXIT_FAILED if _build_samples(args.characters, samples) else EXIT_OK
     names = NETWORK_NAMES if args.what == "skin" else RIG_NETWORK_NAMES
     if args.model not in names:
         raise UsageError(f"train {args.what} needs --model " + "|".join(names) + ".")
@@ -93,14 +93,34 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _build_samples(characters: Path, samples: Path) -> None:
+def _build_samples(characters: Path, samples: Path, split_file: Path | None = None) -> int:
+    """Build (or find cached) the sample of every character of the split, one
+    file at a time so that one file that cannot be read does not stop the
+    others; print a line per file and a summary on stderr.
+
+    Returns
+    -------
+    int, the number of files that failed (each printed with its reason).
+    """
     from ..blender.characters import build_character_samples
     from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
     from ..core.errors import InputError
 
     if not characters.is_dir():
         raise InputError(f"The characters folder '{characters}' does not exist (--characters).")
-    split = read_data_split(DEFAULT_SPLIT_FILE)
+    split = read_data_split(split_file or DEFAULT_SPLIT_FILE)
     paths = [characters / path for path in split.subset("all")]
-    built = build_character_samples(paths, cache_dir=samples, root=characters, split=split)
-    print(f"{len(built)} samples in {os.fspath(samples)}", file=sys.stderr)
+    started, failed = time.perf_counter(), {}
+    for index, path in enumerate(paths):
+        try:
+            sample = build_character_samples([path], cache_dir=samples, root=characters, split=split)[0]
+            outcome = f"{len(sample.vertices)} vertices, {sample.facing}"
+        except Exception as error:  # noqa: BLE001 - one unreadable file must not stop the others
+            failed[path] = str(error) or type(error).__name__
+            outcome = f"FAILED: {failed[path]}"
+        print(f"[{index + 1}/{len(paths)}] {path.relative_to(characters).as_posix()}: {outcome}", file=sys.stderr,
+              flush=True)
+    print(f"{len(paths) - len(failed)} samples in {os.fspath(samples)} ({time.perf_counter() - started:.0f} s); "
+          f"{len(failed)} failed; {len(split.excluded)} files left out by the split (data_split.json 'excluded')",
+          file=sys.stderr)
+    return len(failed)

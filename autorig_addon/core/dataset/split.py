@@ -48,12 +48,15 @@ class DataSplit:
     skeleton_only : dict of str -> str
         Paths whose skin weights are not trusted, with the reason: used for
         skeletons, never for skin weights (:meth:`usable_for`).
+    excluded : dict of str -> str
+        Files of the characters folder on neither side, with the reason.
     """
 
     train: tuple
     validation: tuple
     categories: dict
     skeleton_only: dict = field(default_factory=dict)
+    excluded: dict = field(default_factory=dict)
 
     def usable_for(self, path: str, purpose: str) -> bool:
         """Whether the character at ``path`` (relative, as listed) may be used
@@ -80,7 +83,7 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
     """Read ``data_split.json``.
 
     Accepts ``categories`` as ``{path: category}`` or ``{category: [paths]}``;
-    ``skeleton_only`` (``{path: reason}``) is optional.
+    ``skeleton_only`` and ``excluded`` (``{path: reason}``) are optional.
 
     Raises
     ------
@@ -97,11 +100,14 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
         raise InputError(f"'{path.name}' must be a JSON object with 'train' and 'validation' lists of paths.")
     train = tuple(_split_path(entry) for entry in document["train"])
     validation = tuple(_split_path(entry) for entry in document["validation"])
-    skeleton_only = document.get("skeleton_only", {})
-    if not isinstance(skeleton_only, dict):
-        raise InputError(f"'{path.name}': 'skeleton_only' must map paths to the reason their weights are not used.")
-    return DataSplit(train, validation, _categories(document.get("categories", {})),
-                     {_split_path(key): str(reason) for key, reason in skeleton_only.items()})
+    reasons = {}
+    for key, meaning in (("skeleton_only", "their weights are not used"), ("excluded", "they are left out")):
+        value = document.get(key, {})
+        if not isinstance(value, dict):
+            raise InputError(f"'{path.name}': '{key}' must map paths to the reason {meaning}.")
+        reasons[key] = {_split_path(entry): str(reason) for entry, reason in value.items()}
+    return DataSplit(train, validation, _categories(document.get("categories", {})), reasons["skeleton_only"],
+                     reasons["excluded"])
 
 
 def _split_path(entry) -> str:
