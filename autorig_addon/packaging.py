@@ -7,6 +7,7 @@ sits at the repository top, so a build stages a temporary directory::
                                               training package, training/)
     STAGE/blender_manifest.toml               platforms + wheels rewritten
     STAGE/LICENSE                             the GPL-3.0 text
+    STAGE/CREDITS.md                          who made the characters the networks learn from
     STAGE/wheels/*.whl                        the dependencies Blender lacks (scipy)
 
 and runs Blender's own extension builder (``blender_ext.py build
@@ -239,8 +240,10 @@ def stage_extension(stage_dir: str, wheels_by_platform: dict[str, list[str]]) ->
     """Fill ``stage_dir`` with the add-on sources, the rewritten manifest and
     the wheels of every platform in ``wheels_by_platform``."""
     copy_addon_sources(stage_dir)
-    # The licence text the manifest's `license` names (GPL-3.0-or-later) ships beside the code.
-    shutil.copy2(REPO_ROOT / "LICENSE", os.path.join(stage_dir, "LICENSE"))
+    # The licence text the manifest's `license` names (GPL-3.0-or-later) ships beside the code,
+    # and so do the credits of the (CC-BY, CC-BY-SA, GPL) characters the networks learn from.
+    for name in ("LICENSE", "CREDITS.md"):
+        shutil.copy2(REPO_ROOT / name, os.path.join(stage_dir, name))
     wheel_dir = os.path.join(stage_dir, WHEELS_FOLDER)
     os.makedirs(wheel_dir, exist_ok=True)
     names = []

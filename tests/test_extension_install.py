@@ -220,7 +220,8 @@ def test_linux_zip_contents_and_size(linux_zip):
     with zipfile.ZipFile(linux_zip) as archive:
         names = set(archive.namelist())
         manifest = tomllib.loads(archive.read("blender_manifest.toml").decode())
-    assert {"blender_manifest.toml", "LICENSE", "__init__.py", "core/types.py", "core/nn/layers.py"} <= names
+    assert {"blender_manifest.toml", "LICENSE", "CREDITS.md", "__init__.py", "core/types.py",
+            "core/nn/layers.py"} <= names
     assert not any("__pycache__" in name or name.endswith(".pyc") for name in names)
     assert not any(name.startswith("training/") for name in names), "training code shipped"
     wheels = sorted(name for name in names if name.startswith("wheels/"))

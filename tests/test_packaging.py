@@ -63,11 +63,16 @@ def test_the_manifest_is_the_one_source_of_the_version():
         assert version not in path.read_text(), path
 
 
-def test_the_stage_holds_the_licence_and_the_manifest_beside_the_package(tmp_path):
+def test_the_stage_holds_the_licence_the_credits_and_the_manifest_beside_the_package(tmp_path):
     """Inside the installed extension the manifest sits next to __init__.py
-    (where the package reads its version) and the GPL text comes along."""
+    (where the package reads its version), and the GPL text and the credits come along."""
     packaging.stage_extension(str(tmp_path), {})
     assert (tmp_path / "LICENSE").read_bytes() == (packaging.REPO_ROOT / "LICENSE").read_bytes()
+    assert (tmp_path / "CREDITS.md").read_bytes() == (packaging.REPO_ROOT / "CREDITS.md").read_bytes()
+    credits = (tmp_path / "CREDITS.md").read_text()
+    for author in ("Wildfire Games", "Alientrap", "OpenClonk team", "Red Eclipse team", "SuperTuxKart team",
+                   "GDQuest", "Godot demo projects' authors", "Quaternius", "Kenney", "Kay Lousberg"):
+        assert author in credits, author
     assert (tmp_path / "LICENSE").read_text().startswith("                    GNU GENERAL PUBLIC LICENSE\n"
                                                          "                       Version 3, 29 June 2007\n")
     assert (tmp_path / "__init__.py").is_file()
