@@ -50,7 +50,7 @@ FACING_UNKNOWN = "unknown"
 #: ground (a horse: about 0.9; a biped whose tail hangs below its head: little).
 HEAD_TAIL_MIN_FRACTION = 0.3
 #: A facing snapped from side names is noted as off axis beyond this many
-#: degrees (the Nexuiz idle stances stand turned by 25 to 40 degrees).
+#: degrees (the Nexuiz idle stances stand turned by 23 to 43 degrees).
 OFF_AXIS_NOTE_DEGREES = 15.0
 
 _HEAD_WORD = re.compile(r"head", re.IGNORECASE)
