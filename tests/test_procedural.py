@@ -1,8 +1,4 @@
-"""Tests of the procedural character generator and of the fixed data split."""
-
-import importlib.util
-import json
-import os
+"""Tests of the procedural character generator."""
 
 import numpy as np
 import pytest
@@ -33,7 +29,6 @@ from autorig_addon.core.procedural.rig_builder import TAIL_SHRINK, RigBuilder, c
 from autorig_addon.core.procedural.shapes import box_geometry, ellipsoid_geometry, signed_volume
 from autorig_addon.core.procedural.tubes import round_radii, tapered_radii
 
-REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SEEDS_PER_KIND = (0, 1, 2, 3, 4, 5)
 MIRROR = np.array([-1.0, 1.0, 1.0])
 
@@ -503,71 +498,3 @@ def test_characters_stand_on_the_floor():
         character = generate_character(5, kind)
         assert character.skeleton.joints[:, 2].min() >= -1e-9
         assert abs(min(character.skeleton.joints[:, 2].min(), character.skeleton.tails[:, 2].min())) < 1e-9
-
-
-# --- the fixed split ---------------------------------------------------------------
-
-
-def load_split_script():
-    spec = importlib.util.spec_from_file_location("make_split", os.path.join(REPOSITORY, "scripts", "make_split.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.fixture(scope="module")
-def split():
-    with open(os.path.join(REPOSITORY, "data_split.json"), encoding="utf-8") as handle:
-        return json.load(handle)
-
-
-def test_split_is_disjoint_and_covers_every_character(split):
-    train, validation = set(split["train"]), set(split["validation"])
-    assert not train & validation
-    every = {path for paths in split["categories"].values() for path in paths}
-    assert train | validation == every
-    assert 0.2 <= len(validation) / len(every) <= 0.35
-
-
-def test_every_category_is_in_validation(split):
-    validation = set(split["validation"])
-    for category, paths in split["categories"].items():
-        assert validation & set(paths), category
-        if len(paths) >= 2:
-            assert set(paths) - validation, category
-
-
-def test_split_categories_follow_the_script_rule(split):
-    script = load_split_script()
-    for category, paths in split["categories"].items():
-        for path in paths:
-            assert script.category_of(path) == category
-
-
-def test_near_duplicates_stay_on_one_side(split):
-    validation = set(split["validation"])
-    for group in split["near_duplicates"]:
-        assert len({path in validation for path in group}) == 1
-
-
-def test_split_script_is_deterministic_on_a_synthetic_tree(tmp_path):
-    script = load_split_script()
-    layout = {
-        "quaternius_glb/animals_pack": [f"Animal{k}.glb" for k in range(10)],
-        "quaternius_glb/fish_pack": [f"Fish{k}.glb" for k in range(4)],
-        "quaternius_glb/modular_men": [f"Man{k}.glb" for k in range(7)],
-        "quaternius_glb/modular_women": [f"Woman{k}.glb" for k in range(7)],
-        "khronos": ["RiggedSimple.glb"],
-    }
-    for folder, names in layout.items():
-        os.makedirs(tmp_path / folder)
-        for name in names:
-            (tmp_path / folder / name).write_bytes(b"glTF")
-    first, second = script.make_split(str(tmp_path)), script.make_split(str(tmp_path))
-    assert first == second
-    validation = set(first["validation"])
-    counts = {c: len(validation & set(p)) for c, p in first["categories"].items()}
-    # round(0.28 x 10) = 3 animals, round(0.28 x 4) = 1 fish, round(0.28 x 14) = 4 humans, the lone primitive.
-    assert counts == {"animal": 3, "fish": 1, "human": 4, "primitive": 1}
-    humans = [p for p in validation if "modular" in p]
-    assert {p.split("/")[1] for p in humans} == {"modular_men", "modular_women"}

@@ -1,8 +1,11 @@
-"""The data split's parts on generated data: glTF skins read without Blender, rig families,
-the drawing rule and the skeleton-only flag (no ../shared)."""
+"""The data split on generated data (never ../shared): glTF skins read without Blender, rig families,
+the drawing rule, ``scripts/make_split.py`` on a generated tree, the committed ``data_split.json``,
+and the skeleton-only flag."""
 
+import importlib.util
 import json
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,49 +16,17 @@ from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.dataset.split import PURPOSE_SKELETON, PURPOSE_SKIN, collect_data, read_data_split
 from autorig_addon.core.dataset.split_drawing import TRAIN, VALIDATION, draw_split, interleave_by_folder
 from autorig_addon.core.errors import InputError
-from autorig_addon.core.io.glb import GLB_CHUNK_HEADER, GLB_HEADER, GLB_JSON_CHUNK, GLB_MAGIC
 from autorig_addon.core.io.gltf_skins import SkinRig, declared_skeleton, read_gltf, skin_rigs
 from autorig_addon.core.types import Mesh, Skeleton, Weights
+from gltf_fixtures import skinned_document, write_glb, write_rig_glb
 
-BINARY_CHUNK = 0x004E4942  # "BIN"
 # A skin of four joints: hips -> spine -> head, and hips -> weapon (a prop point no vertex weights).
 JOINT_NAMES = ["hips", "spine", "head", "weapon"]
+PARENTS = [-1, 0, 1, 0]
 # Three vertices: all on hips; half spine, half head (unsigned bytes 128/127 of 255); all on spine.
 JOINTS = np.array([[0, 0, 0, 0], [1, 2, 0, 0], [1, 0, 0, 0]], dtype=np.uint8)
 WEIGHTS = np.array([[255, 0, 0, 0], [128, 127, 0, 0], [255, 0, 0, 0]], dtype=np.uint8)
-
-
-def skinned_document(buffer_uri=None) -> tuple[dict, bytes]:
-    """A glTF document with one skinned triangle and the bytes of its one buffer."""
-    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32).tobytes()
-    binary = positions + JOINTS.tobytes() + WEIGHTS.tobytes()
-    views = [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-             {"buffer": 0, "byteOffset": 36, "byteLength": 12},
-             {"buffer": 0, "byteOffset": 48, "byteLength": 12}]
-    accessors = [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
-                 {"bufferView": 1, "componentType": 5121, "count": 3, "type": "VEC4"},
-                 {"bufferView": 2, "componentType": 5121, "count": 3, "type": "VEC4", "normalized": True}]
-    nodes = [{"name": "hips", "children": [1, 3]}, {"name": "spine", "children": [2]}, {"name": "head"},
-             {"name": "weapon"}, {"name": "body", "mesh": 0, "skin": 0}]
-    buffer = {"byteLength": len(binary)}
-    if buffer_uri:
-        buffer["uri"] = buffer_uri
-    document = {
-        "asset": {"version": "2.0", "extras": {"skeleton": "biped:Biped"}},
-        "nodes": nodes, "skins": [{"joints": [0, 1, 2, 3]}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}]}],
-        "buffers": [buffer], "bufferViews": views, "accessors": accessors,
-    }
-    return document, binary
-
-
-def write_glb(path, document: dict, binary: bytes) -> None:
-    text = json.dumps(document).encode("utf-8")
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    chunks = (GLB_CHUNK_HEADER.pack(len(text), GLB_JSON_CHUNK) + text
-              + GLB_CHUNK_HEADER.pack(len(binary), BINARY_CHUNK) + binary)
-    path.write_bytes(GLB_HEADER.pack(GLB_MAGIC, 2, GLB_HEADER.size + len(chunks)) + chunks)
+EXTRAS = {"skeleton": "biped:Biped"}
 
 
 EXPECTED_RIG = SkinRig(names=("hips", "spine", "head", "weapon"), parents=(-1, 0, 1, 0),
@@ -63,7 +34,7 @@ EXPECTED_RIG = SkinRig(names=("hips", "spine", "head", "weapon"), parents=(-1, 0
 
 
 def test_skins_of_a_glb_give_names_parents_and_the_joints_that_carry_weight(tmp_path):
-    document, binary = skinned_document()
+    document, binary = skinned_document(JOINT_NAMES, PARENTS, JOINTS, WEIGHTS, EXTRAS)
     write_glb(tmp_path / "guy.glb", document, binary)
     read_document, buffers = read_gltf(tmp_path / "guy.glb")
     assert buffers[0][:len(binary)] == binary
@@ -72,7 +43,7 @@ def test_skins_of_a_glb_give_names_parents_and_the_joints_that_carry_weight(tmp_
 
 
 def test_skins_of_a_gltf_read_its_buffer_beside_it(tmp_path):
-    document, binary = skinned_document("guy%20body.bin")
+    document, binary = skinned_document(JOINT_NAMES, PARENTS, JOINTS, WEIGHTS, EXTRAS, "guy%20body.bin")
     (tmp_path / "guy body.bin").write_bytes(binary)
     (tmp_path / "guy.gltf").write_text(json.dumps(document))
     assert skin_rigs(*read_gltf(tmp_path / "guy.gltf")) == (EXPECTED_RIG,)
@@ -256,3 +227,117 @@ def test_skin_evaluation_leaves_skeleton_only_characters_out_and_says_why(tmp_pa
     # With the whole folder ("all"), skin evaluation still leaves them out.
     everything = collect_data([str(root)], "all", str(tmp_path / "split.json"), PURPOSE_SKIN)
     assert [item.name for item in everything] == ["people/painted", "people/val"]
+
+
+# --------------------------------------------------------------------------- scripts/make_split.py
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+
+
+def load_split_script():
+    spec = importlib.util.spec_from_file_location("make_split", REPOSITORY / "scripts" / "make_split.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def chain(prefix: str, count: int = 4) -> tuple[list, list]:
+    """Joint names ``prefix0 .. prefixN`` in one chain: a rig of its own."""
+    return [f"{prefix}{k}" for k in range(count)], [-1] + list(range(count - 1))
+
+
+def generated_tree(root: Path) -> None:
+    """Characters in the data root's folders, each rig written as a .glb."""
+    shared_cow_rig = chain("cow_")
+    write_rig_glb(root / "quaternius_glb/animals_pack/Cow.glb", *shared_cow_rig)  # first split: validation
+    write_rig_glb(root / "quaternius_glb/animals_pack/Bull.glb", *shared_cow_rig)  # first split: training
+    for k in range(10):
+        write_rig_glb(root / f"zeroad_animals/animal_{k}.glb", *chain(f"animal{k}_"))
+    # Two horses whose joints differ but which record one skeleton.
+    write_rig_glb(root / "zeroad_animals/horse_a.glb", *chain("horse_a_"), extras={"skeleton": "horse:Horse"})
+    write_rig_glb(root / "zeroad_animals/horse_b.glb", *chain("horse_b_"), extras={"skeleton": "horse:Horse"})
+    for k in range(5):
+        write_rig_glb(root / f"zeroad_humans/m_tunic__head_{k}.glb", *chain("human_"))
+    write_rig_glb(root / "stk/stk_a.glb", *chain("stk_a_"))
+    write_rig_glb(root / "stk/stk_b.glb", *chain("stk_b_"))
+    write_rig_glb(root / "nexuiz/nexuiz_x.glb", *chain("bip01 "))
+    for k in range(4):
+        write_rig_glb(root / f"gh_quaternius_cute_fish_pack/Fish{k}.glb", *chain("Main"))
+    write_rig_glb(root / "gh_quaternius_via_imagine_dungeons/cleric.glb", *chain("mixamorig:"))
+
+
+def test_split_script_on_a_generated_tree(tmp_path):
+    script = load_split_script()
+    root = tmp_path / "characters"
+    generated_tree(root)
+    first, second = script.make_split(str(root)), script.make_split(str(root))
+    assert first == second
+    side = {path: name for name in (TRAIN, VALIDATION) for path in first[name]}
+    assert len(side) == 26 and not set(first["train"]) & set(first["validation"])
+    # Left out with its reason; skeleton-only kept, with its reason.
+    assert list(first["excluded"]) == ["gh_quaternius_via_imagine_dungeons/cleric.glb"]
+    assert "gh_quaternius_via_imagine_dungeons/cleric.glb" not in side
+    assert first["skeleton_only"] == {"nexuiz/nexuiz_x.glb": script.SKELETON_ONLY["nexuiz/"]}
+    # The first split's sides stay, though Cow and Bull share a rig.
+    assert (side["quaternius_glb/animals_pack/Cow.glb"], side["quaternius_glb/animals_pack/Bull.glb"]) == (
+        VALIDATION, TRAIN)
+    assert {"kind": "quadruped", "side": "both", "members": ["quaternius_glb/animals_pack/Bull.glb",
+                                                            "quaternius_glb/animals_pack/Cow.glb"]} in first["families"]
+    # Families stay whole: the horses (one declared skeleton), the 0 A.D. body, the fish rig.
+    assert side["zeroad_animals/horse_a.glb"] == side["zeroad_animals/horse_b.glb"]
+    assert {side[f"zeroad_humans/m_tunic__head_{k}.glb"] for k in range(5)} == {TRAIN}
+    # Fish: one new family, so it trains. Quadrupeds: 11 new families of 12 files, round(0.28 x 11) = 3 families
+    # within round(0.28 x 12) = 3 files. Humanoids: 4 new families of 8 files: 1 family, within 2 files.
+    # Which ones is the seeded draw's (SPLIT_SEED), the same on every run.
+    assert {side[f"gh_quaternius_cute_fish_pack/Fish{k}.glb"] for k in range(4)} == {TRAIN}
+    assert sorted(first["validation"]) == ["nexuiz/nexuiz_x.glb", "quaternius_glb/animals_pack/Cow.glb",
+                                           "zeroad_animals/animal_1.glb", "zeroad_animals/animal_4.glb",
+                                           "zeroad_animals/animal_5.glb"]
+    assert first["categories"]["humanoid"] == sorted(
+        [f"zeroad_humans/m_tunic__head_{k}.glb" for k in range(5)] + ["nexuiz/nexuiz_x.glb", "stk/stk_a.glb",
+                                                                       "stk/stk_b.glb"])
+
+
+def test_split_script_writes_and_checks_its_file(tmp_path):
+    script = load_split_script()
+    root, output = tmp_path / "characters", tmp_path / "split.json"
+    generated_tree(root)
+    assert script.main(["--root", str(root), "--output", str(output)]) == 0
+    assert script.main(["--root", str(root), "--output", str(output), "--check"]) == 0
+    output.write_text(output.read_text().replace('"seed": 20250301', '"seed": 1'))
+    assert script.main(["--root", str(root), "--output", str(output), "--check"]) == 1
+
+
+@pytest.fixture(scope="module")
+def committed_split():
+    return json.loads((REPOSITORY / "data_split.json").read_text(encoding="utf-8"))
+
+
+def test_committed_split_is_disjoint_and_every_kind_is_on_both_sides(committed_split):
+    train, validation = set(committed_split["train"]), set(committed_split["validation"])
+    assert not train & validation
+    every = {path for paths in committed_split["categories"].values() for path in paths}
+    assert train | validation == every
+    assert not every & set(committed_split["excluded"]) and set(committed_split["skeleton_only"]) <= every
+    assert 0.2 <= len(validation) / len(every) <= 0.35
+    for kind, paths in committed_split["categories"].items():
+        assert validation & set(paths) and set(paths) - validation, kind
+
+
+def test_committed_split_follows_the_script_rule(committed_split):
+    script = load_split_script()
+    for kind, paths in committed_split["categories"].items():
+        assert all(script.kind_of(path) == kind for path in paths)
+    # The first split's 53 characters keep their sides: 15 validation, 38 training.
+    side = {path: name for name in (TRAIN, VALIDATION) for path in committed_split[name]}
+    first = [path for path in side if path.startswith(script.FIRST_SPLIT_FOLDERS)]
+    assert len(first) == 53
+    assert sorted(path for path in first if side[path] == VALIDATION) == sorted(script.FIRST_SPLIT_VALIDATION)
+    # Only families holding first-split characters of both sides straddle, and their new members train.
+    for family in committed_split["families"]:
+        sides = {side[path] for path in family["members"]}
+        assert len(sides) == 1 or family["side"] == "both"
+        if family["side"] == "both":
+            assert {side[path] for path in family["members"] if path not in first} <= {TRAIN}
+    for group in committed_split["near_duplicates"]:
+        assert len({side[path] for path in group}) == 1
