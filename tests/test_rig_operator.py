@@ -125,6 +125,20 @@ def test_bandwidth_reclusters_the_same_armature_live(biped):
     assert rig.live_note(bpy.context) == ("Live: the settings update 'Biped_rig'", "ARMATURE_DATA")
 
 
+@pytest.mark.parametrize("bandwidth", [predict.MIN_BANDWIDTH, predict.MAX_BANDWIDTH])
+def test_the_bandwidth_slider_accepts_its_own_ends(biped, bandwidth):
+    """Blender stores the ends in float32 (0.2 reads back 0.20000000298), a hair outside the core's bounds."""
+    assert bpy.ops.autorig.predict_skeleton(rig_bandwidth=bandwidth) == {"FINISHED"}
+    (armature,) = armatures()
+    votes = rig._prediction_of(armature).votes
+    assert len(armature.data.bones) == predict.skeleton_from_votes(votes, bandwidth=bandwidth).bone_count
+
+    bpy.context.scene.autorig.rig_bandwidth = predict.DEFAULT_BANDWIDTH
+    bone_count_at(bandwidth)  # the panel's slider dragged to the end
+    assert rig.live_note(bpy.context) == ("Live: the settings update 'Biped_rig'", "ARMATURE_DATA")
+    assert len(armature.data.bones) == predict.skeleton_from_votes(votes, bandwidth=bandwidth).bone_count
+
+
 def test_edited_armature_is_left_alone(biped):
     assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
     (armature,) = armatures()

@@ -75,5 +75,19 @@ def option_values(props, table: dict, prefix: str = "") -> dict:
             value = next(choice.value for choice in option.choices if _identifier(choice.value) == value)
         elif option.unit == DEGREES:
             value = math.degrees(value)
+        if option.kind is float:
+            value = _within_table_bounds(option, value)
         values[option.name] = value
     return values
+
+
+def _within_table_bounds(option: Option, value: float) -> float:
+    """``value`` clamped to the table's bounds. Blender keeps a float property
+    in float32 and clamps it to its bounds rounded to float32, so a value
+    set to an end reads back a hair outside the table's bound (0.2 reads
+    0.20000000298) and the core would refuse the end the slider offers."""
+    if option.low is not None:
+        value = max(value, option.low)
+    if option.high is not None:
+        value = min(value, option.high)
+    return value
