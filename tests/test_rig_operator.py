@@ -24,6 +24,7 @@ from blender_fixtures import (
     group_weights,
     make_armature,
     mesh_object,
+    parent_to_bone,
     scene_state,
     select_only,
 )
@@ -137,6 +138,54 @@ def test_the_bandwidth_slider_accepts_its_own_ends(biped, bandwidth):
     bone_count_at(bandwidth)  # the panel's slider dragged to the end
     assert rig.live_note(bpy.context) == ("Live: the settings update 'Biped_rig'", "ARMATURE_DATA")
     assert len(armature.data.bones) == predict.skeleton_from_votes(votes, bandwidth=bandwidth).bone_count
+
+
+def test_a_linked_duplicate_keeps_the_armature_out_of_live_updates(biped):
+    """Rebuilding would replace the bones both objects share: the duplicate
+    (and the mesh bound to it) would lose its armature."""
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    armature = bpy.data.objects["Biped_rig"]
+    select_only([armature], active=armature)
+    bpy.ops.object.duplicate(linked=True)
+    duplicate = bpy.context.active_object
+    cape = mesh_object("Cape", [[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]], [[0, 1, 2]])
+    cape.modifiers.new("Armature", "ARMATURE").object = duplicate
+    select_only([armature], active=armature)
+    bones_before = convert.read_skeleton(armature)
+
+    bpy.context.scene.autorig.rig_bandwidth = COARSE_BANDWIDTH
+
+    assert bpy.data.objects.get(duplicate.name) == duplicate and duplicate.data == armature.data
+    assert cape.modifiers["Armature"].object == duplicate
+    after = convert.read_skeleton(armature)
+    assert after.names == bones_before.names
+    np.testing.assert_array_equal(after.joints, bones_before.joints)
+    assert rig.live_note(bpy.context) == (
+        f"'Biped_rig' shares its bones with '{duplicate.name}' (a linked duplicate): the settings apply at the next "
+        "Predict Skeleton", "INFO")
+
+
+def test_a_prop_on_a_predicted_bone_keeps_the_armature_out_of_live_updates(biped):
+    """A rebuild moves or removes the bone the prop hangs on: it would jump."""
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    armature = bpy.data.objects["Biped_rig"]
+    lantern = bpy.data.objects.new("Lantern", None)  # an empty: no mesh, so never "bound"
+    bpy.context.scene.collection.objects.link(lantern)
+    lantern.location = (0.1, -0.1, 0.5)
+    bpy.context.view_layer.update()
+    root_bone = convert.read_skeleton(armature).names[0]
+    parent_to_bone(lantern, armature, root_bone)
+    place_before = np.array(lantern.matrix_world)
+    bones_before = convert.read_skeleton(armature)
+
+    bpy.context.scene.autorig.rig_bandwidth = COARSE_BANDWIDTH
+    bpy.context.view_layer.update()
+
+    assert convert.read_skeleton(armature).names == bones_before.names
+    np.testing.assert_allclose(np.array(lantern.matrix_world), place_before, atol=1e-6)
+    assert lantern.parent == armature and lantern.parent_bone == root_bone
+    assert rig.live_note(bpy.context) == (
+        "'Biped_rig' carries 'Lantern' on its bones: the settings apply at the next Predict Skeleton", "INFO")
 
 
 def test_edited_armature_is_left_alone(biped):

@@ -21,7 +21,9 @@ Every question the jobs ask is read off that list:
 - :func:`is_unbound`: a mesh a run may weight when none is named: bound to
   no armature, or a prop on a bone (the run then leaves it rigid);
 - :func:`posing_armatures`: the armatures whose pose moves a mesh (the
-  ones put at rest while it is read).
+  ones put at rest while it is read);
+- :func:`followers`: every object an armature's bones move (what a
+  rebuilt or removed armature would leave behind or displace).
 
 Nothing here writes weights: binding a mesh is :mod:`.weight_writer`'s.
 """
@@ -105,6 +107,14 @@ def is_unbound(obj) -> bool:
     such a prop rigid and says so)."""
     bindings = armature_bindings(obj)
     return not bindings or bindings[0].bone is not None
+
+
+def followers(armature) -> list:
+    """The objects of the file whose shape or place hangs on ``armature``'s
+    bones: those it deforms or carries (:func:`armature_bindings`) and any
+    other child of it (an empty on a bone, a curve), in the file's order."""
+    return [obj for obj in bpy.data.objects if obj.parent == armature
+            or any(binding.armature == armature for binding in armature_bindings(obj))]
 
 
 def posing_armatures(objects) -> list:

@@ -15,8 +15,9 @@ is ever left half built.
 Live level of detail: the network outputs of each prediction stay in memory
 (:data:`_PREDICTIONS`, keyed by a token stored on the armature as the custom
 property :data:`PREDICTED_PROPERTY`). While that armature is what the
-prediction built (its rest bones unchanged, not in Edit Mode, no mesh bound
-to it: ``armature_binding.bound_armature``), changing the Rig panel's *Bandwidth*, *Density Threshold* or
+prediction built (its rest bones unchanged, not in Edit Mode, nothing
+bound to or carried by it: ``armature_binding.followers``, no linked
+duplicate sharing its bones), changing the Rig panel's *Bandwidth*, *Density Threshold* or
 *Symmetry* re-clusters the cached votes and rebuilds its bones in place
 (:func:`update_live_prediction`, a fraction of a second); once the artist
 edits it, the settings wait for the next *Predict Skeleton*.
@@ -34,12 +35,13 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.geometry.outliers import require_finite_positions
+from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
 from ...core.rigging.predict import JointVotes, predict_votes, skeleton_from_votes
 from ...core.skeleton.checks import skeleton_extent
 from ...core.types import Mesh, Skeleton
 from .. import convert
-from ..armature_binding import bound_armature, remove_armature, unbind
+from ..armature_binding import bound_armature, deforms, followers, remove_armature, unbind
 from ..armature_builder import build_armature
 from ..snapshot import restored_on_failure
 from .input_checks import check_mode
@@ -243,7 +245,8 @@ def live_armature(context) -> tuple[object, str]:
 
     The active object if it is a predicted armature, else the most recently
     predicted one in the scene. Returns ``(armature, "")`` when it can be
-    updated, ``(None, note)`` when it cannot (edited, in Edit Mode, bound),
+    updated, ``(None, note)`` when it cannot (edited, in Edit Mode, anything
+    bound to or carried by it, a linked duplicate sharing its bones),
     ``(None, "")`` when there is none.
     """
     scene_objects = set(context.scene.objects)
@@ -260,9 +263,18 @@ def live_armature(context) -> tuple[object, str]:
         return None, f"'{armature.name}' is in Edit Mode: the settings wait for the next Predict Skeleton"
     if not _unedited(armature, _prediction_of(armature).built):
         return None, f"'{armature.name}' was edited: the settings apply at the next Predict Skeleton"
-    bound = [obj.name for obj in context.scene.objects if obj.type == "MESH" and bound_armature(obj) == armature]
-    if bound:
-        return None, f"'{armature.name}' is bound to meshes: the settings apply at the next Predict Skeleton"
+    # Rebuilding replaces the bones (and their datablock): whatever hangs on them would move or lose them.
+    waiting = "the settings apply at the next Predict Skeleton"
+    carried = followers(armature)
+    if any(deforms(armature, obj) for obj in carried):
+        return None, f"'{armature.name}' is bound to meshes: {waiting}"
+    if carried:
+        names = listed_names([obj.name for obj in carried], quoted=True)
+        return None, f"'{armature.name}' carries {names} on its bones: {waiting}"
+    duplicates = [obj.name for obj in bpy.data.objects if obj.data == armature.data and obj != armature]
+    if duplicates:
+        names = listed_names(duplicates, quoted=True)
+        return None, f"'{armature.name}' shares its bones with {names} (a linked duplicate): {waiting}"
     return armature, ""
 
 
