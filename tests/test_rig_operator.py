@@ -242,7 +242,7 @@ def test_mesh_without_faces_is_refused_and_scene_unchanged(clean_scene):
     assert scene_state([points]) == before and len(bpy.data.armatures) == 0
 
 
-def test_auto_rig_refuses_a_bound_mesh_unless_replace(biped):
+def test_auto_rig_refuses_a_bound_mesh_unless_replace(biped, capfd):
     old = make_armature("Old")
     modifier = biped.modifiers.new("Armature", "ARMATURE")
     modifier.object = old
@@ -262,7 +262,24 @@ def test_auto_rig_refuses_a_bound_mesh_unless_replace(biped):
     assert [(m.type, m.object) for m in biped.modifiers] == [("ARMATURE", new)]
     groups = {group.name for group in biped.vertex_groups}
     assert "Lower" not in groups and "Mask" in groups  # the old bones' groups go, the artist's stay
-    assert bpy.data.objects.get("Old") is not None  # the old armature itself stays in the scene
+    # Nothing else follows the old armature: it goes, its data with it.
+    assert bpy.data.objects.get("Old") is None and len(bpy.data.armatures) == 1
+    assert "the old armature 'Old' was removed (no other object follows it)." in capfd.readouterr().out
+
+
+def test_replace_binding_keeps_an_old_armature_another_mesh_follows(biped, capfd):
+    old = make_armature("Old")
+    for obj in (biped, mesh_object("Boots", [[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]], [[0, 1, 2]])):
+        obj.modifiers.new("Armature", "ARMATURE").object = old
+    select_only([biped], active=biped)
+    old_bones = [bone.name for bone in old.data.bones]
+
+    assert bpy.ops.autorig.auto_rig(rig_replace=True) == {"FINISHED"}
+
+    assert [(m.type, m.object) for m in biped.modifiers] == [("ARMATURE", bpy.data.objects["Biped_rig"])]
+    assert bpy.data.objects.get("Old") == old and [bone.name for bone in old.data.bones] == old_bones
+    assert bpy.data.objects["Boots"].modifiers["Armature"].object == old
+    assert "the old armature 'Old' stays: 'Boots' still follow it." in capfd.readouterr().out
 
 
 def test_cancel_while_skinning_leaves_nothing(biped):

@@ -41,7 +41,7 @@ from ...core.rigging.predict import JointVotes, predict_votes, skeleton_from_vot
 from ...core.skeleton.checks import skeleton_extent
 from ...core.types import Mesh, Skeleton
 from .. import convert
-from ..armature_binding import bound_armature, deforms, followers, remove_armature, unbind
+from ..armature_binding import armature_bindings, bound_armature, deforms, followers, remove_armature, unbind
 from ..armature_builder import build_armature
 from ..snapshot import restored_on_failure
 from .input_checks import check_mode
@@ -95,7 +95,8 @@ class RigPlan:
     name : str, the name of the armature to build
     settings : RigSettings
     skin : SkinSettings or None, bind the meshes with these (Auto-Rig) or not
-    replace : bool, unbind meshes already bound to an armature before binding them
+    replace : bool, unbind meshes already bound to an armature before binding them, and remove
+        that armature afterwards when nothing else follows it
     named : bool, the user picked the meshes (False: every mesh of a file; see ``plan_skin``)
     """
 
@@ -192,6 +193,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
     votes = yield lambda progress: predict_votes(plan.mesh, sub_progress(progress, 0.0, share))
     skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
+    replaced = _followed_armatures(plan.meshes) if plan.skin is not None and plan.replace else []
     armature = build_armature(skeleton, plan.name, context)
     try:
         armature.show_in_front = True  # the bones are inside the body
@@ -211,7 +213,30 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     except BaseException:
         remove_armature(armature)
         raise
+    # Last, once nothing can fail: a removed armature cannot be restored.
+    result.notes = (*result.notes, *_remove_unused(replaced))
     return result
+
+
+def _followed_armatures(meshes) -> list:
+    """The armatures ``meshes`` follow (deformed or carried), each once."""
+    return list(dict.fromkeys(binding.armature for obj in meshes for binding in armature_bindings(obj)))
+
+
+def _remove_unused(armatures) -> list[str]:
+    """Remove the armatures Replace Binding took the meshes from where
+    nothing follows them any more (a leftover armature would still look like
+    the character's rig); keep the others. Returns a note for each."""
+    notes = []
+    for armature in armatures:
+        users = [obj.name for obj in followers(armature)]
+        name = armature.name
+        if users:
+            notes.append(f"the old armature '{name}' stays: {listed_names(users, quoted=True)} still follow it")
+        else:
+            remove_armature(armature)
+            notes.append(f"the old armature '{name}' was removed (no other object follows it)")
+    return notes
 
 
 def run_steps(steps: Generator, progress: ProgressCallback | None = None):

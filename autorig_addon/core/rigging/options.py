@@ -34,5 +34,5 @@ RIG_OPTIONS = option_table(
 REPLACE_BINDING = Option(
     "replace", bool, False, "Replace Binding",
     "Meshes already bound to an armature lose that binding (its Armature modifier and bone groups) and are bound "
-    "to the new skeleton; otherwise they are refused",
+    "to the new skeleton, and the old armature is removed when nothing else follows it; otherwise they are refused",
     flag=None)
