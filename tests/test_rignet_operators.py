@@ -199,13 +199,40 @@ def test_import_that_fails_while_writing_leaves_neither_armature_nor_groups(clea
     assert "rig" not in bpy.data.objects and "rig" not in bpy.data.armatures
 
 
+def test_import_normalises_weights_the_file_left_unnormalised_and_says_so(clean_scene, tmp_path, capfd):
+    import bpy
+
+    from blender_fixtures import mesh_object
+
+    path = tmp_path / "loud.txt"
+    path.write_text("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
+                    "skin 0 root 5.0\n"             # one bone at 5: becomes 1
+                    "skin 1 root 5.0 tip 15.0\n"    # sums to 20: becomes 0.25 / 0.75
+                    "skin 2 root 0.1 tip 0.2\n"     # sums to 0.3: becomes 1/3 / 2/3
+                    "skin 3 root 0.5 tip 0.5\n"     # already sums to 1
+                    "skin 4 root 0.0 tip 0.0\n")    # sums to 0: stays unweighted
+    fan = mesh_object("Fan", [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [-1, 1, 0]],
+                      [[0, 1, 2], [0, 2, 3], [0, 3, 4]])
+    bpy.context.view_layer.update()
+    select_only([fan], active=fan)
+    capfd.readouterr()
+
+    assert bpy.ops.autorig.import_rignet(filepath=str(path)) == {"FINISHED"}
+
+    np.testing.assert_allclose(group_weights(fan, ("root", "tip")),
+                               [[1, 0], [0.25, 0.75], [1 / 3, 2 / 3], [0.5, 0.5], [0, 0]], atol=1e-6)
+    assert ("Imported 'loud' with 2 bones, 'Fan' bound (1 of its vertices have no weight in the file and stay in "
+            "place when posed); the weights of 3 vertices did not sum to 1 in the file (sums from 0.3 to 20); each "
+            "was scaled to sum to 1.") in capfd.readouterr().out
+
+
 def test_import_without_a_mesh_builds_the_armature_alone(clean_scene, tmp_path):
     import bpy
 
     path = tmp_path / "alone.txt"
     path.write_text(TWO_JOINT_RIG)
-    armature = rignet.import_rignet_rig(bpy.context, str(path))
-    assert armature.name == "alone"
+    armature, notes = rignet.import_rignet_rig(bpy.context, str(path))
+    assert armature.name == "alone" and notes == []
     assert [(bone.name, bone.parent.name if bone.parent else None) for bone in armature.data.bones] == [
         ("root", None), ("tip", "root")]
     np.testing.assert_allclose([tuple(bone.head_local) for bone in armature.data.bones], [[0, 0, 0], [0, 0, 1]])

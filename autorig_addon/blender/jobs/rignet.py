@@ -13,6 +13,8 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.io.rignet_rig import read_rignet_rig, write_rignet_rig
+from ...core.types import Weights
+from ...core.weights import normalize_rows
 from .. import convert
 from ..armature_binding import remove_armature
 from ..armature_builder import build_armature
@@ -25,15 +27,21 @@ from ..weight_writer import write_weights
 #: (Fewer unweighted vertices are legal: the format has no line for a vertex
 #: without weight, so a file cannot say how many trailing vertices it skips.)
 MAX_UNWEIGHTED_SHARE = 0.5
+#: A file's vertex whose weights sum further than this from 1 is counted as
+#: normalised in the report (RigNet's own files round weights, so their sums
+#: are off by about 1e-4).
+WEIGHT_SUM_TOLERANCE = 1e-3
 
 
-def import_rignet_rig(context, filepath: str, mesh_obj=None):
+def import_rignet_rig(context, filepath: str, mesh_obj=None) -> tuple[object, list[str]]:
     """Build the armature of a RigNet file; bind ``mesh_obj`` with its weights.
 
-    Returns the armature object. ``mesh_obj`` (optional) must have more
-    vertices than the file's largest ``skin`` index, and the file must weight
-    at least ``1 - MAX_UNWEIGHTED_SHARE`` of them (vertices without a ``skin``
-    line stay unweighted: see :func:`unweighted_vertex_count`).
+    Returns the armature object and notes for the report (weights the file
+    did not normalise: see :func:`normalised_file_weights`). ``mesh_obj``
+    (optional) must have more vertices than the file's largest ``skin``
+    index, and the file must weight at least ``1 - MAX_UNWEIGHTED_SHARE`` of
+    them (vertices without a ``skin`` line stay unweighted: see
+    :func:`unweighted_vertex_count`).
     All-or-nothing: on failure nothing is left in the scene and the mesh is
     unchanged. A mesh shared with other objects (linked duplicates) gets
     its own copy first.
@@ -41,12 +49,14 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
     vertex_count = len(mesh_obj.data.vertices) if mesh_obj is not None else None
     skeleton, weights = read_rignet_rig(filepath, vertex_count=vertex_count)
     bind = mesh_obj is not None and weights is not None
+    notes = []
     if bind:
         _check_weights_cover_mesh(weights, mesh_obj)
+        weights, notes = normalised_file_weights(weights)
     name = os.path.splitext(os.path.basename(filepath))[0] or "RigNet"
     armature = build_armature(skeleton, name, context)
     if not bind:
-        return armature
+        return armature, notes
     try:
         with restored_on_failure([mesh_obj]):
             # A linked duplicate gets its own mesh, or the weights would land
@@ -56,7 +66,24 @@ def import_rignet_rig(context, filepath: str, mesh_obj=None):
     except BaseException:
         remove_armature(armature)
         raise
-    return armature
+    return armature, notes
+
+
+def normalised_file_weights(weights: Weights) -> tuple[Weights, list[str]]:
+    """A file's weights with each vertex's row scaled to sum to 1, and a
+    note counting the vertices whose sum was off by more than
+    :data:`WEIGHT_SUM_TOLERANCE`. The format does not require sums of 1, but
+    Blender cuts a vertex group's weight to at most 1 (a row of 5.0 and 0.5
+    would become 1.0 and 0.5, other proportions) and what reads the weights
+    back (our export, glTF, game engines) expects rows summing to 1. A row
+    of zeros stays unweighted (the report counts those)."""
+    sums = weights.matrix.sum(axis=1)
+    off = (sums > 0) & (np.abs(sums - 1.0) > WEIGHT_SUM_TOLERANCE)
+    normalised = Weights(normalize_rows(weights.matrix), weights.bone_names)
+    if not off.any():
+        return normalised, []
+    return normalised, [f"the weights of {np.count_nonzero(off)} vertices did not sum to 1 in the file (sums "
+                        f"from {sums[off].min():g} to {sums[off].max():g}); each was scaled to sum to 1"]
 
 
 def unweighted_vertex_count(weights) -> int:

@@ -38,7 +38,7 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
         mesh_obj = _active_mesh(context)
         shared = shared_mesh_notes([mesh_obj]).get(mesh_obj) if mesh_obj is not None else None
         try:
-            armature = import_rignet_rig(context, self.filepath, mesh_obj)
+            armature, notes = import_rignet_rig(context, self.filepath, mesh_obj)
         except (InputError, OSError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -48,6 +48,7 @@ class AUTORIG_OT_import_rignet(bpy.types.Operator, ImportHelper):
             stays = (f" ({unweighted} of its vertices have no weight in the file and stay in place when posed)"
                      if unweighted else "")
             bound = f", '{mesh_obj.name}' bound{stays}" + (f"; it {shared}" if shared else "")
+        bound += "".join(f"; {note}" for note in notes)
         self.report({"INFO"}, f"Imported '{armature.name}' with {len(armature.data.bones)} bones{bound}.")
         return {"FINISHED"}
 
