@@ -226,6 +226,26 @@ def test_import_normalises_weights_the_file_left_unnormalised_and_says_so(clean_
             "was scaled to sum to 1.") in capfd.readouterr().out
 
 
+def test_export_in_edit_mode_writes_the_unsaved_bone_edits_and_stays_in_edit_mode(clean_scene, tmp_path):
+    import bpy
+
+    armature = make_armature("Rig")
+    select_only([armature], active=armature)
+    bpy.ops.object.mode_set(mode="EDIT")
+    upper = armature.data.edit_bones[UPPER_BONE]
+    upper.use_connect = False
+    upper.head = (0.2, 0.0, 1.1)  # was (0, 0, 1); not saved to the armature data until Edit Mode is left
+    path = tmp_path / "rig.txt"
+
+    assert bpy.ops.autorig.export_rignet(filepath=str(path)) == {"FINISHED"}
+
+    skeleton, _ = read_rignet_rig(str(path))
+    np.testing.assert_allclose(skeleton.joints[skeleton.names.index(UPPER_BONE)], [0.2, 0.0, 1.1], atol=1e-6)
+    assert armature.mode == "EDIT" and bpy.context.mode == "EDIT_ARMATURE"
+    np.testing.assert_allclose(tuple(armature.data.edit_bones[UPPER_BONE].head), [0.2, 0.0, 1.1], atol=1e-6)
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
 def test_import_without_a_mesh_builds_the_armature_alone(clean_scene, tmp_path):
     import bpy
 

@@ -106,7 +106,14 @@ def _check_weights_cover_mesh(weights, mesh_obj) -> None:
 
 
 def export_rignet_rig(filepath: str, armature_obj, mesh_obj=None) -> None:
-    """Write the armature's deform bones (and ``mesh_obj``'s weights) to ``filepath``."""
+    """Write the armature's deform bones (and ``mesh_obj``'s weights) to ``filepath``.
+
+    An object in Edit Mode stays in it: its unsaved edits (moved bones,
+    weights edited in Edit Mode) are first copied to its data, which is
+    what is read, so the file holds what the user sees."""
+    for obj in (armature_obj, mesh_obj):
+        if obj is not None and obj.mode == "EDIT":
+            obj.update_from_editmode()
     skeleton = convert.read_skeleton(armature_obj).deform_subset()
     if skeleton.bone_count == 0:
         raise InputError(f"'{armature_obj.name}' has no deform bones to export.")
