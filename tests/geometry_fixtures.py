@@ -46,6 +46,14 @@ def cylinder(radius: float = 0.1, height: float = 1.0, segments: int = 24, rings
     return Mesh(V, F)
 
 
+def triangle_and_flat_triangles(flat_count: int) -> Mesh:
+    """One triangle of area 0.5 at z = 1, then ``flat_count`` triangles
+    without area: consecutive points 0.1 apart on the x axis."""
+    V = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]] + [[0.1 * k, 0, 0] for k in range(flat_count + 2)], dtype=float)
+    F = np.array([[0, 1, 2]] + [[3 + k, 4 + k, 5 + k] for k in range(flat_count)])
+    return Mesh(V, F)
+
+
 def subdivided(mesh: Mesh, times: int) -> Mesh:
     """``mesh`` with every triangle split in four ``times`` times (same
     shape, about four times the vertices each time), one object."""

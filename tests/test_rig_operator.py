@@ -28,6 +28,7 @@ from blender_fixtures import (
     scene_state,
     select_only,
 )
+from geometry_fixtures import triangle_and_flat_triangles
 
 #: A symmetric procedural biped (1,866 vertices, 29 bones in its own rig, 1.0 tall).
 BIPED_SEED = 0
@@ -240,6 +241,22 @@ def test_mesh_without_faces_is_refused_and_scene_unchanged(clean_scene):
             "Add faces to it (Edit Mode > Face > Fill) or pick a mesh with a surface.")):
         bpy.ops.autorig.predict_skeleton()
     assert scene_state([points]) == before and len(bpy.data.armatures) == 0
+
+
+def test_a_triangle_padded_with_flat_faces_is_refused_and_scene_unchanged(clean_scene):
+    """One real triangle plus 16 without area passed the 16-face minimum and was rigged."""
+    mesh = triangle_and_flat_triangles(predict.MIN_FACES)
+    padded = mesh_object("Padded", mesh.vertices, mesh.triangles)
+    bpy.context.view_layer.update()
+    assert len(padded.data.polygons) == 17
+    select_only([padded], active=padded)
+    before = scene_state([padded])
+    for operator in (bpy.ops.autorig.predict_skeleton, bpy.ops.autorig.auto_rig):
+        with pytest.raises(RuntimeError, match=re.escape(
+                "The mesh has 1 faces with an area (16 more have none: remove them with Mesh > Clean Up > "
+                "Degenerate Dissolve); predicting a skeleton needs a character surface of at least 16.")):
+            operator()
+        assert scene_state([padded]) == before and len(bpy.data.armatures) == 0
 
 
 def test_auto_rig_refuses_a_bound_mesh_unless_replace(biped, capfd):

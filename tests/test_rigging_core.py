@@ -21,7 +21,7 @@ from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
 from autorig_addon.core.types import Mesh, Skeleton
 from autorig_addon.training.rigging.training_set import joint_targets
-from geometry_fixtures import box_mesh, cylinder
+from geometry_fixtures import box_mesh, cylinder, triangle_and_flat_triangles
 
 # --------------------------------------------------------------------------
 # Mean shift
@@ -543,6 +543,14 @@ def test_a_mesh_with_too_few_faces_is_refused(face_count):
         predict.predict_skeleton(Mesh(vertices, triangles))
     assert str(raised.value) == (f"The mesh has {face_count} faces; predicting a skeleton needs a character surface "
                                  f"of at least {predict.MIN_FACES}.")
+
+
+def test_faces_without_area_do_not_count_toward_the_fewest_faces():
+    with pytest.raises(InputError) as raised:
+        predict.predict_skeleton(triangle_and_flat_triangles(16))
+    assert str(raised.value) == (
+        "The mesh has 1 faces with an area (16 more have none: remove them with Mesh > Clean Up > Degenerate "
+        f"Dissolve); predicting a skeleton needs a character surface of at least {predict.MIN_FACES}.")
 
 
 def test_a_mesh_with_nan_vertices_is_refused(biped):

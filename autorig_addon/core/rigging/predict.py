@@ -26,6 +26,8 @@ import numpy as np
 
 from ..dataset.normalise import apply_transform, normalisation_transform
 from ..errors import InputError
+from ..geometry.bounding_box import bounding_box_diagonal
+from ..geometry.normals import triangle_double_areas
 from ..geometry.outliers import without_vertices
 from ..geometry.proxy import simplified_proxy
 from ..nn.numpy_kernels import NUMPY, sigmoid
@@ -61,8 +63,12 @@ DEFAULT_SYMMETRY = True
 #: Joints this close to the mirror plane, or to their twin's mirror image,
 #: are snapped (share of the bandwidth).
 SNAP_SHARE = 0.5
-#: Fewest faces a mesh needs: below this there is no shape to read.
+#: Fewest faces with an area a mesh needs: below this there is no shape to read.
 MIN_FACES = 16
+#: A face whose area is below this share of the squared diagonal of the
+#: mesh's bounding box has none (collapsed, or its corners on a line): it
+#: does not count toward :data:`MIN_FACES`.
+FLAT_FACE_AREA_SHARE = 1e-12
 #: Length of a bone the tree gives no direction (a lone joint), share of
 #: the largest side, pointing up; also the shortest a leaf is cut to.
 LONE_BONE_LENGTH = 0.02
@@ -119,6 +125,27 @@ def facing_turns(vertices: np.ndarray) -> int:
     return 1 if best == 1 else 0
 
 
+def require_enough_faces(mesh: Mesh) -> None:
+    """Refuse a mesh with fewer than :data:`MIN_FACES` faces with an area
+    (:data:`FLAT_FACE_AREA_SHARE`): faces without one (a triangle with
+    its corners on a line) add no shape, only a count.
+
+    Raises
+    ------
+    InputError naming the faces with and without an area.
+    """
+    floor = FLAT_FACE_AREA_SHARE * bounding_box_diagonal(mesh.vertices) ** 2
+    has_area = 0.5 * triangle_double_areas(mesh.vertices, mesh.triangles) > floor
+    count = int(np.count_nonzero(has_area))
+    if count >= MIN_FACES:
+        return
+    flat = len(has_area) - count
+    without = (f" with an area ({flat} more have none: remove them with Mesh > Clean Up > Degenerate Dissolve)"
+               if flat else "")
+    raise InputError(f"The mesh has {count} faces{without}; predicting a skeleton needs a character surface of at "
+                     f"least {MIN_FACES}.")
+
+
 def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> JointVotes:
     """Run the joint network on ``mesh`` (see the module docstring).
 
@@ -129,19 +156,17 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
 
     Raises
     ------
-    InputError for a mesh with too few faces or lying on its side.
+    InputError for a mesh with too few faces with an area, or lying on its side.
     """
-    if len(mesh.triangles) < MIN_FACES:
-        raise InputError(f"The mesh has {len(mesh.triangles)} faces; predicting a skeleton needs a character "
-                         f"surface of at least {MIN_FACES}.")
-    weights = shipped_weights(joint_network.SPEC).weights
-    report(progress, 0.0, "Simplifying the mesh")
     # Vertices in no face have no surface to read; the proxy would keep them.
     faceless = np.ones(mesh.vertex_count, dtype=bool)
     faceless[mesh.triangles] = False
     surface = Mesh(*without_vertices(mesh.vertices, mesh.triangles, faceless)[1:])
     if not np.all(np.isfinite(surface.vertices)):
         raise InputError("The mesh has vertices at NaN or infinite positions; fix them before predicting a skeleton.")
+    require_enough_faces(surface)
+    weights = shipped_weights(joint_network.SPEC).weights
+    report(progress, 0.0, "Simplifying the mesh")
     proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
     transform = normalisation_transform(proxy.vertices)
     notes = []
