@@ -189,6 +189,17 @@ def test_skeleton_only_characters_serve_skeletons_and_never_skin_weights(tmp_pat
         read_data_split(tmp_path / "bad.json")
 
 
+def test_families_of_the_split_map_each_member_to_its_family(tmp_path):
+    families = [{"kind": "humanoid", "side": "train", "members": ["bots/rigid.glb", "bots/rigid_val.glb"]},
+                {"kind": "humanoid", "side": "both", "members": ["people/painted.glb", "people/val.glb"]}]
+    (tmp_path / "split.json").write_text(json.dumps({**SPLIT, "families": families}))
+    assert read_data_split(tmp_path / "split.json").families == {
+        "bots/rigid.glb": 0, "bots/rigid_val.glb": 0, "people/painted.glb": 1, "people/val.glb": 1}
+    (tmp_path / "bad.json").write_text(json.dumps({**SPLIT, "families": {"bots": ["bots/rigid.glb"]}}))
+    with pytest.raises(InputError, match="'families' must be a list of objects with a 'members' list of paths"):
+        read_data_split(tmp_path / "bad.json")
+
+
 def save_sample(folder, name: str) -> None:
     mesh = Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 0, 2]], float), np.array([[0, 1, 2]]))
     skeleton = Skeleton(np.array([[0, 0, 0], [0, 0, 1]], float), [-1, 0], ("hips", "head"))

@@ -50,6 +50,10 @@ class DataSplit:
         skeletons, never for skin weights (:meth:`usable_for`).
     excluded : dict of str -> str
         Files of the characters folder on neither side, with the reason.
+    families : dict of str -> int
+        Skeleton family (index in the file's ``families`` list) of each
+        listed path: characters sharing a rig or a body, which the split
+        keeps on one side and training samples evenly.
     """
 
     train: tuple
@@ -57,6 +61,7 @@ class DataSplit:
     categories: dict
     skeleton_only: dict = field(default_factory=dict)
     excluded: dict = field(default_factory=dict)
+    families: dict = field(default_factory=dict)
 
     def usable_for(self, path: str, purpose: str) -> bool:
         """Whether the character at ``path`` (relative, as listed) may be used
@@ -107,12 +112,20 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
             raise InputError(f"'{path.name}': '{key}' must map paths to the reason {meaning}.")
         reasons[key] = {_split_path(entry): str(reason) for entry, reason in value.items()}
     return DataSplit(train, validation, _categories(document.get("categories", {})), reasons["skeleton_only"],
-                     reasons["excluded"])
+                     reasons["excluded"], _families(document.get("families", []), path.name))
 
 
 def _split_path(entry) -> str:
     text = entry.get("path", "") if isinstance(entry, dict) else str(entry)
     return Path(text).as_posix()
+
+
+def _families(raw, file_name: str) -> dict:
+    """``{path: family index}`` of the file's ``families`` list (``[{"members": [paths], ...}, ...]``)."""
+    if not isinstance(raw, list) or not all(isinstance(family, dict) and isinstance(family.get("members"), list)
+                                            for family in raw):
+        raise InputError(f"'{file_name}': 'families' must be a list of objects with a 'members' list of paths.")
+    return {_split_path(member): index for index, family in enumerate(raw) for member in family["members"]}
 
 
 def _categories(raw) -> dict:

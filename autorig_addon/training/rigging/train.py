@@ -7,7 +7,10 @@ cache; their examples with stretched variants are built once or reused
 (sorted by name) is held out to pick the epoch and scored as it is, not on
 its stretched copies. Then :func:`..nn.fit.fit`:
 
-* ``joints``: one character per step, turned by a random angle about the up
+* ``joints``: one character per step, at most
+  :data:`..runs.CHARACTERS_PER_FAMILY` of each skeleton family per epoch,
+  each as itself or one of its stretched variants drawn at random
+  (:func:`..runs.epoch_steps`), turned by a random angle about the up
   axis and mirrored with probability one half (:mod:`..nn.augmentation`;
   the feature columns of :data:`...core.rigging.joint_features.VERTEX_VECTORS`
   and the targets turn with it). Loss: the L1 distance between each moved
@@ -45,7 +48,15 @@ from ..nn.augmentation import turn_and_mirror, turned_columns
 from ..nn.fit import FitRecord, fit
 from ..nn.modules import NetworkModule, as_tensors
 from ..nn.torch_kernels import TORCH
-from ..runs import held_out_names, procedural_samples, start_run, write_weights
+from ..runs import (
+    character_families,
+    epoch_step_count,
+    epoch_steps,
+    held_out_names,
+    procedural_samples,
+    start_run,
+    write_weights,
+)
 from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
 
 #: Weight of the attention loss beside the offset loss.
@@ -103,14 +114,23 @@ def train_joint_network(train: list, holdout: list, record: FitRecord) -> dict:
     tensors = [tuple(as_tensors(value, record.device) for value in (
         example.graph, example.graph.vertices.astype(np.float32), example.target_points, example.attention))
         for example in train]
+    characters = [example_character(example.name) for example in train]
+    families = character_families(characters)
+    steps = epoch_step_count(characters, families)
+    record.details.update(train_characters=len(set(characters)), steps_per_epoch=steps)
 
     def epoch_losses():
-        for index in rng.permutation(len(tensors)):
+        for index in epoch_steps(characters, families, rng):
             yield lambda: joint_loss(module, tensors[index], torch.as_tensor(
                 turn_and_mirror(rng), dtype=torch.float32, device=record.device))
 
     return fit(module, epoch_losses, lambda weights: {"cd_j2j": holdout_j2j(weights, holdout)}, record=record,
-               steps_per_epoch=len(tensors))
+               steps_per_epoch=steps)
+
+
+def example_character(name: str) -> str:
+    """The character an example was made from (its name is ``CHARACTER#VARIANT``)."""
+    return name.rsplit("#", 1)[0]
 
 
 def _jittered_joints(example: RigExample, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -131,7 +151,10 @@ def _jittered_joints(example: RigExample, rng: np.random.Generator) -> tuple[np.
 
 
 def connectivity_data(examples: list, rng: np.random.Generator) -> dict:
-    """Pair features and labels, root features and root index, per jittered copy."""
+    """Pair features and labels, and root features with each jittered copy's
+    root, per jittered copy: ``roots`` lists ``(features, root)`` per copy;
+    ``root_features``, ``root_copy`` (the copy of each row) and ``root_rows``
+    (each copy's root row) hold the same stacked, for one batched loss."""
     pairs_x, pairs_y, roots = [], [], []
     for example in examples:
         solid = solid_depth(example.mesh)
@@ -143,21 +166,29 @@ def connectivity_data(examples: list, rng: np.random.Generator) -> dict:
             pairs_x.append(pair_features(joints, pairs, solid, twins))
             pairs_y.append(np.array([(a, b) in bones for a, b in pairs.tolist()], dtype=np.float32))
             roots.append((root_features(joints, solid), root))
-    return {"pair_features": np.concatenate(pairs_x), "pair_labels": np.concatenate(pairs_y), "roots": roots}
+    counts = np.array([len(features) for features, _ in roots], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    return {"pair_features": np.concatenate(pairs_x), "pair_labels": np.concatenate(pairs_y), "roots": roots,
+            "root_features": np.concatenate([features for features, _ in roots]),
+            "root_copy": np.repeat(np.arange(len(roots)), counts),
+            "root_rows": starts + np.array([root for _, root in roots], dtype=np.int64)}
 
 
 def connectivity_loss(spec: NetworkSpec, params: dict, data: dict, device: str) -> torch.Tensor:
     """The bone network's binary cross-entropy over every pair, or the root
-    network's cross-entropy over each copy's joints."""
+    network's cross-entropy over each copy's joints (all copies at once: a
+    log-sum-exp per copy)."""
     if spec.name == "bones":
         logits = spec.forward(TORCH, params, torch.as_tensor(data["pair_features"], device=device))
         return torch.nn.functional.binary_cross_entropy_with_logits(
             logits, torch.as_tensor(data["pair_labels"], device=device))
-    losses = [torch.nn.functional.cross_entropy(
-        spec.forward(TORCH, params, torch.as_tensor(features, device=device))[None],
-        torch.tensor([root], device=device))
-        for features, root in data["roots"]]
-    return torch.stack(losses).mean()
+    scores = spec.forward(TORCH, params, torch.as_tensor(data["root_features"], device=device))
+    copy = torch.as_tensor(data["root_copy"], device=device)
+    copies = len(data["roots"])
+    highest = torch.full((copies,), -torch.inf, device=device).scatter_reduce(0, copy, scores.detach(), "amax")
+    sums = torch.zeros(copies, device=device).index_add(0, copy, torch.exp(scores - highest[copy]))
+    log_partition = highest + torch.log(sums)
+    return (log_partition - scores[torch.as_tensor(data["root_rows"], device=device)]).mean()
 
 
 def connectivity_accuracy(network: str, weights: dict, data: dict) -> float:
@@ -173,8 +204,7 @@ def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, re
     rng = np.random.default_rng(record.seed)
     module = NetworkModule(spec).to(record.device)
     train_data, held_data = connectivity_data(train, rng), connectivity_data(holdout, rng)
-    features = train_data["pair_features"] if spec.name == "bones" else np.concatenate(
-        [features for features, _ in train_data["roots"]])
+    features = train_data["pair_features" if spec.name == "bones" else "root_features"]
     module.standardise_from(torch.as_tensor(features, device=record.device))
 
     def held_loss(weights: dict) -> dict:

@@ -6,7 +6,10 @@
    (:mod:`.training_set`).
 2. Every :data:`...runs.HOLDOUT_EVERY`-th training character (sorted by
    name) is held out to pick the epoch; its variants are not trained on.
-3. :func:`...nn.fit.fit`: one character per step, turned by a random angle
+3. :func:`...nn.fit.fit`: one character per step, at most
+   :data:`...runs.CHARACTERS_PER_FAMILY` of each skeleton family per epoch,
+   each as itself or one of its variants drawn at random
+   (:func:`...runs.epoch_steps`), turned by a random angle
    about the up axis and mirrored left-right with probability one half
    (:func:`...nn.augmentation.turn_and_mirror` on the feature vectors:
    neither changes a distance, so no example has to be rebuilt). The loss
@@ -38,7 +41,15 @@ from ...nn.augmentation import turn_and_mirror, turned_columns
 from ...nn.fit import FitRecord, Log, fit, log_to_stderr
 from ...nn.modules import NetworkModule, as_tensors
 from ...nn.torch_kernels import TORCH
-from ...runs import held_out_names, procedural_samples, start_run, write_weights
+from ...runs import (
+    character_families,
+    epoch_step_count,
+    epoch_steps,
+    held_out_names,
+    procedural_samples,
+    start_run,
+    write_weights,
+)
 from .training_set import build_examples, load_example
 
 #: What the kept epoch minimises.
@@ -90,7 +101,8 @@ def train_network(spec: SkinNetworkSpec, train: list, holdout: list, record: Fit
     Parameters
     ----------
     spec : SkinNetworkSpec
-    train : list of ``(name, graph, target)``: numpy SkinGraph and (n, K) targets
+    train : list of ``(name, graph, target)``: numpy SkinGraph and (n, K)
+        targets; ``name`` is ``CHARACTER--VARIANT``
     holdout : list of ``(name, graph, reference)``: scored after each epoch
     record : FitRecord of the run (settings in, results out)
     log : where the progress lines go
@@ -100,16 +112,25 @@ def train_network(spec: SkinNetworkSpec, train: list, holdout: list, record: Fit
     tensors = [(as_tensors(graph, record.device), torch.as_tensor(target, device=record.device))
                for _, graph, target in train]
     held = [(graph, reference) for _, graph, reference in holdout]
-    record.details.update(train_examples=len(train), holdout_examples=[name for name, _, _ in holdout])
+    characters = [example_character(name) for name, _, _ in train]
+    families = character_families(characters)
+    steps = epoch_step_count(characters, families)
+    record.details.update(train_examples=len(train), train_characters=len(set(characters)), steps_per_epoch=steps,
+                          holdout_examples=[name for name, _, _ in holdout])
 
     def epoch_losses():
-        for index in rng.permutation(len(tensors)):
+        for index in epoch_steps(characters, families, rng):
             graph, target = tensors[index]
             yield lambda: candidate_cross_entropy(predicted_weights(module, augmented(graph, turn_and_mirror(rng))),
                                                   target)
 
     return fit(module, epoch_losses, lambda weights: holdout_scores(spec, weights, held), record=record,
-               steps_per_epoch=len(tensors), log=log)
+               steps_per_epoch=steps, log=log)
+
+
+def example_character(name: str) -> str:
+    """The character an example was made from (its name is ``CHARACTER--VARIANT``)."""
+    return name.rsplit("--", 1)[0]
 
 
 def run_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None, epochs: Optional[int] = None,
