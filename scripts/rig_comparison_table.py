@@ -6,7 +6,8 @@ Prints a summary with one row per method (each metric as ``mean / median``
 over the characters it scored, RigNet's metrics: Chamfer distances in units
 of the largest side of the character's bounding box), then one row per
 character with each metric as ``first / second / ...`` in the order given
-(the table of scripts/skin_comparison_table.py).
+(the table of scripts/skin_comparison_table.py), after the same per kind
+and per skeleton family of ``data_split.json``.
 """
 
 import json
@@ -15,7 +16,7 @@ import sys
 import numpy as np
 
 from autorig_addon.core.evaluation.report import METRIC_KEYS
-from skin_comparison_table import character_table, format_cell
+from skin_comparison_table import character_table, family_groups, format_cell, group_tables, kind_groups
 
 METRICS = METRIC_KEYS["rig"]
 #: Metrics where higher is better; lower is better for the others.
@@ -36,6 +37,10 @@ def main(paths) -> int:
             cells.append(f"{format_cell(np.mean(values))} / {format_cell(np.median(values))}" if values else "-")
         failed = len(report["characters"]) - len(scored)
         print(f"| {method} | {len(scored)} | {failed} | " + " | ".join(cells) + " |")
+    print("\n### Per kind\n")
+    print("\n".join(group_tables(reports, METRICS, kind_groups(reports[0]), "kind")))
+    print("### Per skeleton family\n")
+    print("\n".join(group_tables(reports, METRICS, family_groups(reports[0]), "family")))
     print(f"\n### Per character\n\nEach cell: {' / '.join(methods)}. Lower is better except "
           f"{', '.join(HIGHER_IS_BETTER)}.\n")
     print("\n".join(character_table(reports, METRICS)))
