@@ -114,6 +114,19 @@ def epoch_step_count(example_characters: Sequence[str], families: dict[str, int]
     return sum(min(size, per_family) for size in sizes.values())
 
 
+def family_sample(names: Sequence[str], families: dict[str, int], per_family: int) -> list[str]:
+    """At most ``per_family`` of ``names`` from each family, the first by
+    sorted name: the same every call."""
+    taken: dict[int, int] = {}
+    kept = []
+    for name in sorted(names):
+        family = families[name]
+        if taken.get(family, 0) < per_family:
+            taken[family] = taken.get(family, 0) + 1
+            kept.append(name)
+    return kept
+
+
 def procedural_samples(count: int) -> list[CharacterSample]:
     """The procedural characters of seeds ``0 .. count - 1`` as samples
     (weights from how each piece was built, :mod:`autorig_addon.core.procedural`);
