@@ -4,11 +4,41 @@ Blender-backed fixtures import ``bpy`` lazily, so test modules that only
 exercise ``core`` never load Blender.
 """
 
+import os
+import sys
 from pathlib import Path
 
 import pytest
 
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
+
+#: (major, minor) of the bpy modules that crash when the interpreter exits once
+#: a class with a Python property callback (``update``, ``poll``) has been
+#: registered, even after unregistering it: bpy 4.2's static destructors free
+#: Python objects after Python has shut down (``bpy_class_free`` in
+#: ``~SpaceType``, segmentation fault). A bug of the module, not the add-on's:
+#: a one-property group with an ``update`` callback does it, and the add-on's
+#: scene settings have such callbacks. bpy 4.5 and 5.0 exit cleanly.
+BPY_CRASHING_AT_EXIT = {(4, 2)}
+_EXIT_STATUS = pytest.StashKey[int]()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionfinish(session, exitstatus):
+    session.config.stash[_EXIT_STATUS] = int(exitstatus)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    """Under a bpy of :data:`BPY_CRASHING_AT_EXIT`, end the process with the
+    session's exit status once everything is reported, before that crash
+    would replace it."""
+    bpy = sys.modules.get("bpy")
+    if bpy is None or tuple(bpy.app.version[:2]) not in BPY_CRASHING_AT_EXIT or _EXIT_STATUS not in config.stash:
+        return
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(config.stash[_EXIT_STATUS])
 
 
 @pytest.fixture(scope="session")

@@ -28,6 +28,8 @@ import pytest
 
 from autorig_addon import packaging
 
+pytestmark = pytest.mark.all_blenders
+
 LINUX = "linux-x64"
 ADDON_MODULE = "bl_ext.user_default.autorig_addon"
 RESULT_PREFIX = "RESULT_JSON:"

@@ -34,6 +34,8 @@ from blender_fixtures import (
     select_only,
 )
 
+pytestmark = pytest.mark.all_blenders
+
 #: A helmet: a box around the top of the Upper bone.
 HELMET_CENTER, HELMET_HALF_SIZE = (0.0, 0.0, 1.8), 0.35
 #: How far the Upper bone is turned to compare the prop's motion, degrees.

@@ -30,6 +30,8 @@ from blender_fixtures import (
 )
 from geometry_fixtures import triangle_and_flat_triangles
 
+pytestmark = pytest.mark.all_blenders
+
 #: A symmetric procedural biped (1,866 vertices, 29 bones in its own rig, 1.0 tall).
 BIPED_SEED = 0
 #: A bone tail may stick out of the mesh's bounding box by this share of its

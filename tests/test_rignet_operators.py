@@ -19,6 +19,8 @@ from blender_fixtures import (
     select_only,
 )
 
+pytestmark = pytest.mark.all_blenders
+
 #: Two joints up z, a root and its child, vertices 0 to 2 skinned.
 TWO_JOINT_RIG = ("joints root 0 0 0\njoints tip 0 0 1\nroot root\nhier root tip\n"
                  "skin 0 root 1.0\nskin 1 tip 1.0\nskin 2 root 0.5 tip 0.5\n")

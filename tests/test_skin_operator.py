@@ -28,6 +28,8 @@ from blender_fixtures import (
     select_only,
 )
 
+pytestmark = pytest.mark.all_blenders
+
 
 def unbound_cylinder(name="Tube"):
     import bpy

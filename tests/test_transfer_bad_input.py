@@ -19,6 +19,8 @@ from autorig_addon.core.errors import InputError
 from autorig_addon.core.transfer.transfer import VertexStatus
 from blender_fixtures import LOWER_BONE, UPPER_BONE, build_rig_scene, local_positions, scene_state, select_only
 
+pytestmark = pytest.mark.all_blenders
+
 BONES = [LOWER_BONE, UPPER_BONE]
 #: Body vertices above this height lose their weights in the tests (the sleeve reaches z = 1.8).
 UNPAINTED_ABOVE = 1.45

@@ -35,6 +35,8 @@ from blender_fixtures import (
     select_only,
 )
 
+pytestmark = pytest.mark.all_blenders
+
 BONES = [LOWER_BONE, UPPER_BONE]
 #: The operator's report for the reference sleeve: 544 tube vertices copied,
 #: the 8 of the button (a part with no match) inpainted.
