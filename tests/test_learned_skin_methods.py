@@ -55,7 +55,7 @@ CHARACTER_SEED, CHARACTER_KIND = 3, "biped"
 #: many deform bones as it has candidates, its spec's min_deform_bones).
 TWO_BONE_METHODS = tuple(m for m in SKIN_METHODS if m not in SKIN_NETWORKS or SKIN_NETWORKS[m].min_deform_bones <= 2)
 TWO_BONE_NETWORKS = tuple(m for m in NETWORK_NAMES if m in TWO_BONE_METHODS)
-RIGNET_TOO_FEW_BONES = ("rignet needs at least 5 deform bones and the armature has 2: use heterskinnet, skinningnet "
+RIGNET_TOO_FEW_BONES = ("rignet needs at least 3 deform bones and the armature has 2: use heterskinnet, skinningnet "
                         "or geometric for so small a skeleton.")
 UNKNOWN_METHOD = "Unknown skinning method 'magic': use one of geometric, rignet, heterskinnet, skinningnet."
 

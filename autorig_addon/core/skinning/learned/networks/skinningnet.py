@@ -52,7 +52,8 @@ SPEC = SkinNetworkSpec(
         Dense("join", (2 * WIDTH + PAIR_FEATURES, WIDTH, WIDTH, 1), zero_last=True),
     ),
     forward=skinningnet_scores,
-    training=TrainingSettings(epochs=40, learning_rate=2e-3),
+    # 20 epochs of 128 family-sampled steps, as RigNet's (docs/models.md).
+    training=TrainingSettings(epochs=20, learning_rate=2e-3),
     weights_file=TRAINED_FOLDER / "skinningnet.npz",
     distance="geodesic",
     prior="geometric",
