@@ -44,12 +44,14 @@ from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_p
 from .tree_features import candidate_pairs, pair_features, root_features
 
 #: Mean-shift bandwidth, share of the character's largest side: the level
-#: of detail (smaller: more joints). On the held-out training characters
-#: (``scripts/tune_rig_clustering.py``, docs/models.md) CD-J2J is flat from
-#: 0.01 to 0.0175 (0.0351 to 0.0358) while the joint count falls from 3.3
-#: to 1.11 times the artists'; the default is the coarsest bandwidth within
-#: 0.001 of the best CD-J2J.
-DEFAULT_BANDWIDTH = 0.0175
+#: of detail (smaller: more joints). On the held-out training characters of
+#: the 419-character split (``scripts/tune_rig_clustering.py``,
+#: docs/models.md) CD-J2J falls with the bandwidth only by finding ever more
+#: joints (0.0559 at 0.01 with 17 times the artists' joints, 0.0589 at
+#: 0.0175 with 4 times), while joint IoU peaks from 0.0225 to 0.035 (0.095
+#: to 0.096); the default is the finest bandwidth within 0.001 of the best
+#: IoU (0.0225: IoU 0.095, CD-J2J 0.0614, 2.5 times the artists' joints).
+DEFAULT_BANDWIDTH = 0.0225
 MIN_BANDWIDTH = 0.01
 MAX_BANDWIDTH = 0.2
 #: Modes with less vote density than this share of the strongest are not
