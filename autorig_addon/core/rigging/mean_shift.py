@@ -13,6 +13,7 @@ bandwidth takes a fraction of a second.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 #: Votes with less attention than this are left out (they would move the
@@ -34,18 +35,16 @@ def _kernel_step(seeds: np.ndarray, tree: cKDTree, points: np.ndarray, weights: 
     """Weighted kernel means at ``seeds`` and the kernel density there."""
     near = cKDTree(seeds).sparse_distance_matrix(tree, KERNEL_REACH * bandwidth, output_type="ndarray")
     values = np.exp(-0.5 * (near["v"] / bandwidth) ** 2) * weights[near["j"]]
-    # Sums per seed by bincount: building a sparse matrix each step cost more than the sums.
-    seed, vote = near["i"], near["j"]
-    density = np.bincount(seed, values, minlength=len(seeds))
-    sums = np.stack([np.bincount(seed, values * points[vote, axis], minlength=len(seeds)) for axis in range(3)], axis=1)
-    means = np.divide(sums, density[:, None], out=seeds.copy(), where=density[:, None] > 0)
+    kernel = sp.csr_matrix((values, (near["i"], near["j"])), shape=(len(seeds), len(points)))
+    density = np.asarray(kernel.sum(axis=1)).reshape(-1)
+    means = np.divide(kernel @ points, density[:, None], out=seeds.copy(), where=density[:, None] > 0)
     return means, density
 
 
 def _merged(seeds: np.ndarray, spacing: float) -> np.ndarray:
-    """Indices of the seeds to keep: one per cell of a grid of ``spacing`` (seeds that met)."""
+    """One seed per cell of a grid of ``spacing``: seeds that met."""
     _, first = np.unique(np.floor(seeds / spacing).astype(np.int64), axis=0, return_index=True)
-    return np.sort(first)
+    return seeds[np.sort(first)]
 
 
 def mean_shift_modes(points: np.ndarray, weights: np.ndarray, bandwidth: float,
@@ -80,7 +79,7 @@ def mean_shift_modes(points: np.ndarray, weights: np.ndarray, bandwidth: float,
     for _ in range(MAX_ITERATIONS):
         moved, _ = _kernel_step(seeds, tree, points, weights, bandwidth)
         step = np.linalg.norm(moved - seeds, axis=1).max()
-        seeds = moved[_merged(moved, SEED_MERGE_SHARE * bandwidth)]
+        seeds = _merged(moved, SEED_MERGE_SHARE * bandwidth)
         if step < CONVERGED_STEP * bandwidth:
             break
     _, density = _kernel_step(seeds, tree, points, weights, bandwidth)
