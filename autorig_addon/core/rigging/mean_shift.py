@@ -84,7 +84,12 @@ def mean_shift_modes(points: np.ndarray, weights: np.ndarray, bandwidth: float,
             break
     _, density = _kernel_step(seeds, tree, points, weights, bandwidth)
     modes, mode_density = [], []
-    for index in np.argsort(-density, kind="stable"):
+    # Strongest first; densities within a millionth of the strongest's tie and
+    # go by position, so mirrored joints (equal density up to rounding, which
+    # differs with the number of BLAS threads) come in the same order on every
+    # machine.
+    rounded = np.round(density / max(float(density.max(initial=0.0)), 1e-300), 6)
+    for index in np.lexsort((seeds[:, 2], seeds[:, 1], seeds[:, 0], -rounded)):
         if all(np.linalg.norm(seeds[index] - mode) > bandwidth for mode in modes):
             modes.append(seeds[index])
             mode_density.append(density[index])
