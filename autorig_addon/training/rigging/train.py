@@ -76,10 +76,11 @@ MAX_VOTER_WEIGHT = 20.0
 JOINT_JITTER = 0.01
 #: Jittered copies of each example's joints.
 JITTER_COPIES = 4
-#: Held-out characters per skeleton family the joint network is scored on
-#: after each epoch: the mean shift takes about 1.5 s a character, and the
-#: 54 held-out characters (22 of them 0 A.D. humans on one skeleton) would
-#: take most of each epoch's time.
+#: Held-out characters per skeleton family every skeleton network is scored
+#: on after each epoch: for the joint network the mean shift takes about
+#: 1.5 s a character, and the 54 held-out characters (22 of them 0 A.D.
+#: humans on one skeleton) would take most of each epoch's time and weigh
+#: one family most.
 SCORED_PER_FAMILY = 2
 #: Epochs between progress lines (and history entries) of the full-batch networks.
 FULL_BATCH_LOG_EVERY = 100
