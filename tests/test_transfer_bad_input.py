@@ -97,6 +97,39 @@ def test_a_garment_in_other_units_is_refused_unless_poor_matches_are_allowed(rig
     np.testing.assert_allclose(convert.read_weights(rig.sleeve, BONES).matrix.sum(axis=1), 1.0, atol=1e-6)
 
 
+def scale_sleeve_about_body_centre(rig, scale):
+    """A wrong object scale: the sleeve scaled about the body's centre (not applied)."""
+    centre = 0.5 * (local_positions(rig.body).min(axis=0) + local_positions(rig.body).max(axis=0))
+    rig.sleeve.scale = (scale, scale, scale)
+    rig.sleeve.location = centre - scale * centre
+    bpy.context.view_layer.update()
+
+
+@pytest.mark.parametrize("scale, size", [(1.8, "large"), (1 / 1.8, "small")])
+def test_a_garment_at_another_scale_is_refused_like_one_in_other_units(rig, scale, size, capfd):
+    scale_sleeve_about_body_centre(rig, scale)
+    # A tube around the body's cylinder fits it over a range of scales, 2.54
+    # about the origin among them: a unit factor, tried first, may be named.
+    words = (rf"'Sleeve' looks (\d\.\d+) times too {size} for 'Body' "
+             r"\((a wrong object scale|[a-z ]+ mixed up)\?\): scaled by (1/)?\1, \d+% of it would match the body\.")
+    refused_unchanged(rig, ".*" + words + ".*" + re.escape(
+        "To transfer anyway, turn on Allow Poor Match (--allow-poor-match on the command line)."),
+        source="Body", targets="Sleeve")
+    found = re.search(words, capfd.readouterr().out)
+    if found.group(2) == "a wrong object scale":
+        assert 1.2 <= float(found.group(1)) <= 2.2  # the scale that fits, not a unit factor
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve", allow_poor_match=True) == {"FINISHED"}
+    np.testing.assert_allclose(convert.read_weights(rig.sleeve, BONES).matrix.sum(axis=1), 1.0, atol=1e-6)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1.05])
+def test_a_garment_at_its_scale_or_a_loose_one_is_not_flagged(rig, scale, capfd):
+    scale_sleeve_about_body_centre(rig, scale)
+    assert bpy.ops.autorig.transfer_weights(source="Body", targets="Sleeve") == {"FINISHED"}
+    assert "too large" not in capfd.readouterr().out
+    assert np.all(status(rig.sleeve) != VertexStatus.INPAINTED)
+
+
 def test_the_panels_allow_poor_match_reaches_the_operator(rig):
     rig.sleeve.scale = (2.54, 2.54, 2.54)
     bpy.context.view_layer.update()

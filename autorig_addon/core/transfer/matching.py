@@ -13,7 +13,8 @@ the inpainting, and its fallback row is that of the nearest source vertex
 with usable weights, so no row is ever empty.
 
 :func:`likely_unit_factor` tells, when little matches, whether the target
-would fit the source at another unit scale (2.54, 100, ...).
+would fit the source at another unit scale (2.54, 100, ...) or at another
+uniform scale (a wrong object scale: 1.8).
 """
 
 from __future__ import annotations
@@ -43,6 +44,18 @@ UNIT_FACTOR_SAMPLES = 256
 UNIT_FACTOR_MIN_NEAR_SHARE = 0.5
 #: ... and at least this many times the share that does at the current scale.
 UNIT_FACTOR_MIN_GAIN = 2.0
+#: Other uniform scales (a wrong object scale) are searched from this factor
+#: away from 1 (a loose garment, 1.05, is never one) ...
+OTHER_SCALE_MIN = 1.25
+#: ... up to this one (farther, the unit factors or the size check answer) ...
+OTHER_SCALE_MAX = 20.0
+#: ... first in steps of this ratio, then around the best in steps of :data:`OTHER_SCALE_FINE_STEP`.
+OTHER_SCALE_STEP = 1.08
+OTHER_SCALE_FINE_STEP = 1.01
+#: Scales whose share lies within this of the best fit about as well.
+OTHER_SCALE_SHARE_TOLERANCE = 0.02
+#: The wording of a scale that is no unit factor.
+OTHER_SCALE_UNITS = ""
 
 
 @dataclass(frozen=True)
@@ -141,7 +154,8 @@ class UnitFactor:
     Attributes
     ----------
     factor : float, the target's size over the size it should have (> 1: too large)
-    units : str, the units that differ by this factor ("inches and centimetres")
+    units : str, the units that differ by this factor ("inches and centimetres"),
+        empty for a scale no unit mix-up gives (a wrong object scale, 1.8)
     near_share : float in [0, 1], share of the sampled target vertices that
         would match (near, normals agreeing) once scaled by ``1 / factor``
     """
@@ -152,19 +166,23 @@ class UnitFactor:
 
     def describe(self, target_name: str, source_name: str) -> str:
         """E.g. "'Skirt' looks 2.54 times too large for 'Body' (inches and
-        centimetres mixed up?): scaled by 1/2.54, 96% of it would match the body."."""
+        centimetres mixed up?): scaled by 1/2.54, 96% of it would match the body.",
+        or "'Dress' looks 1.8 times too large for 'Body' (a wrong object
+        scale?): scaled by 1/1.8, 90% of it would match the body."."""
         size = max(self.factor, 1.0 / self.factor)
         large = self.factor > 1.0
-        scale = f"1/{size:.4g}" if large else f"{size:.4g}"
-        return (f"'{target_name}' looks {size:.4g} times too {'large' if large else 'small'} for '{source_name}' "
-                f"({self.units} mixed up?): scaled by {scale}, {100.0 * self.near_share:.0f}% of it would match "
+        digits = ".4g" if self.units else ".3g"
+        scale = f"1/{size:{digits}}" if large else f"{size:{digits}}"
+        cause = f"{self.units} mixed up?" if self.units else "a wrong object scale?"
+        return (f"'{target_name}' looks {size:{digits}} times too {'large' if large else 'small'} for "
+                f"'{source_name}' ({cause}): scaled by {scale}, {100.0 * self.near_share:.0f}% of it would match "
                 "the body.")
 
 
 def likely_unit_factor(source: TransferSource, target: Mesh, target_normals: np.ndarray, distance_fraction: float,
                        max_normal_angle: float, accept_flipped_normals: bool) -> UnitFactor | None:
-    """The unit factor at which ``target`` best fits ``source``, if one fits
-    much better than the current scale.
+    """The unit factor, else the other uniform scale, at which ``target``
+    best fits ``source``, if one fits much better than the current scale.
 
     Each factor of :data:`UNIT_FACTORS` and its inverse scales a sample of
     the target's vertices about the world origin (a file in other units)
@@ -172,6 +190,12 @@ def likely_unit_factor(source: TransferSource, target: Mesh, target_normals: np.
     as well as the share of scaled vertices that would match: within
     ``distance_fraction`` of the scaled target's diagonal of the source
     surface, normals agreeing (a uniform scale keeps the normals).
+
+    When no unit factor fits, other scales from :data:`OTHER_SCALE_MIN` to
+    :data:`OTHER_SCALE_MAX` (and their inverses) are searched the same way,
+    about the origin, the target's centre and the source's centre: a grid
+    of ratio :data:`OTHER_SCALE_STEP`, then a finer one around the best,
+    whose best-fitting range gives the factor named.
 
     Parameters
     ----------
@@ -207,18 +231,70 @@ def likely_unit_factor(source: TransferSource, target: Mesh, target_normals: np.
     if needed > 1.0:
         return None  # no scale can match twice as many
     centre = 0.5 * (target.vertices.min(axis=0) + target.vertices.max(axis=0))
+
+    def best_of(trials: list[tuple[float, str, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+        """Indices of the ``trials`` (factor, units, pivot) that could reach
+        the share needed, and their shares."""
+        points = np.concatenate([pivot + (sample - pivot) / factor for factor, _, pivot in trials])
+        distances = np.repeat([match_distance / factor for factor, _, _ in trials], len(sample))
+        near = ~source.query.surely_farther(points, distances)
+        # A scale whose samples mostly lie surely too far cannot reach the
+        # share needed: only the others take the exact test.
+        hopeful = np.flatnonzero(near.reshape(len(trials), len(sample)).mean(axis=1) >= needed)
+        if not len(hopeful):
+            return hopeful, np.zeros(0)
+        rows = (hopeful[:, None] * len(sample) + np.arange(len(sample))).ravel()
+        return hopeful, match_shares(points[rows], distances[rows], near[rows])
+
     trials = [(factor, units, pivot) for base, units in UNIT_FACTORS.items()
               for factor in (base, 1.0 / base) for pivot in (np.zeros(3), centre)]
-    points = np.concatenate([pivot + (sample - pivot) / factor for factor, _, pivot in trials])
-    distances = np.repeat([match_distance / factor for factor, _, _ in trials], len(sample))
-    near = ~source.query.surely_farther(points, distances)
-    # A scale whose samples mostly lie surely too far cannot reach the share
-    # needed: only the others take the exact test.
-    hopeful = np.flatnonzero(near.reshape(len(trials), len(sample)).mean(axis=1) >= needed)
-    if not len(hopeful):
+    hopeful, shares = best_of(trials)
+    if len(hopeful) and shares.max() >= needed:
+        factor, units, _ = trials[hopeful[int(np.argmax(shares))]]
+        return UnitFactor(factor, units, float(shares.max()))
+    source_centre = 0.5 * (source.mesh.vertices.min(axis=0) + source.mesh.vertices.max(axis=0))
+    return _other_scale(best_of, needed, (np.zeros(3), centre, source_centre))
+
+
+def _other_scale(best_of, needed: float, pivots) -> UnitFactor | None:
+    """The uniform scale, no unit factor, that fits best (see
+    :func:`likely_unit_factor`), if it reaches the share ``needed``."""
+    steps = int(np.ceil(np.log(OTHER_SCALE_MAX / OTHER_SCALE_MIN) / np.log(OTHER_SCALE_STEP)))
+    sizes = OTHER_SCALE_MIN * OTHER_SCALE_STEP ** np.arange(steps + 1)
+    trials = [(factor, OTHER_SCALE_UNITS, pivot) for size in sizes for factor in (size, 1.0 / size)
+              for pivot in pivots]
+    hopeful, shares = best_of(trials)
+    if not len(hopeful) or shares.max() < needed:
         return None
-    rows = (hopeful[:, None] * len(sample) + np.arange(len(sample))).ravel()
-    shares = match_shares(points[rows], distances[rows], near[rows])
-    factor, units, _ = trials[hopeful[int(np.argmax(shares))]]
-    best = UnitFactor(factor, units, float(shares.max()))
-    return best if best.near_share >= needed else None
+    # Many scales fit a garment close to the body about as well (its
+    # distance from the body allows some): the middle, in log scale, of the
+    # run of scales about the best one's pivot that fit about as well as it
+    # is the factor named, refined on a finer grid.
+    chosen = hopeful[int(np.argmax(shares))]
+    side = 1.0 if trials[chosen][0] > 1.0 else -1.0
+    pivot_index = chosen % len(pivots)
+    good = {int(i) // (2 * len(pivots)) for i, share in zip(hopeful, shares)
+            if share >= shares.max() - OTHER_SCALE_SHARE_TOLERANCE and i % len(pivots) == pivot_index
+            and (trials[i][0] > 1.0) == (side > 0)}
+    low, high = _run_around(good, chosen // (2 * len(pivots)))
+    pivot = pivots[pivot_index]
+    count = int(np.ceil(np.log(sizes[high] / sizes[low] * OTHER_SCALE_STEP ** 2) / np.log(OTHER_SCALE_FINE_STEP)))
+    fine = sizes[low] / OTHER_SCALE_STEP * OTHER_SCALE_FINE_STEP ** np.arange(count + 1)
+    fine = fine[fine >= OTHER_SCALE_MIN] ** side
+    hopeful, shares = best_of([(factor, OTHER_SCALE_UNITS, pivot) for factor in fine])
+    if not len(hopeful) or shares.max() < needed:
+        return None
+    good = {int(i) for i, share in zip(hopeful, shares) if share >= shares.max() - OTHER_SCALE_SHARE_TOLERANCE}
+    low, high = _run_around(good, int(hopeful[int(np.argmax(shares))]))
+    factor = float(np.sqrt(fine[low] * fine[high]))
+    return UnitFactor(factor, OTHER_SCALE_UNITS, float(shares.max()))
+
+
+def _run_around(members: set[int], start: int) -> tuple[int, int]:
+    """The first and last of the run of consecutive ``members`` holding ``start``."""
+    low = high = start
+    while low - 1 in members:
+        low -= 1
+    while high + 1 in members:
+        high += 1
+    return low, high
