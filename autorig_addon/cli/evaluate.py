@@ -143,13 +143,16 @@ def evaluate_skin_item(item: DataItem, method: str) -> dict:
 def evaluate_rig_item(item: DataItem, method: str) -> dict:
     """Load one character, predict its rig from the mesh alone and score it."""
     from ..blender.characters import load_character
+    from ..core.evaluation.key_joint_metrics import score_key_joints
     from ..core.evaluation.skeleton_metrics import evaluate_rig
     from ..core.geometry.bounding_box import largest_side
 
     character = load_character(item.path, item.name, item.category)
     predicted, seconds = _predict_timed(rig_predictor(method), character.mesh, item)
     # RigNet's unit: the largest side of the bounding box, not the diagonal the skin metrics use.
-    scores = evaluate_rig(predicted.skeleton, character.skeleton, largest_side(character.mesh.vertices))
+    size = largest_side(character.mesh.vertices)
+    scores = evaluate_rig(predicted.skeleton, character.skeleton, size)
+    scores.update(score_key_joints(predicted.skeleton, character.mesh, character.skeleton, size))
     return {**scores, "seconds": seconds, "notes": list(character.notes) + list(predicted.notes)}
 
 

@@ -22,7 +22,8 @@ import numpy as np
 #: Metric keys of each task, in table order.
 METRIC_KEYS = {
     "skin": ("l1", "precision", "recall", "deform_mean", "deform_max"),
-    "rig": ("cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit"),
+    "rig": ("cd_j2j", "cd_j2b", "cd_b2b", "iou", "precision", "recall", "tree_edit", "key_joints",
+            "key_joints_present"),
     "transfer": ("stretch_p99", "stretch_max", "deform_mean", "deform_max"),
 }
 #: Extra per-character keys shown in the tables and summarised.
