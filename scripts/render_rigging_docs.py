@@ -5,11 +5,12 @@ Usage (from the repo root)::
     .venv/bin/python scripts/render_rigging_docs.py [--out docs/images] [--lod-character PATH] [CHARACTER.glb ...]
 
 1. For each character (default: four validation characters of
-   data_split.json), side by side: the artist's deform skeleton and the
-   skeleton predicted at ``core.rigging.predict.DEFAULT_BANDWIDTH``
-   -> ``rigging_<Name>.png``.
+   data_split.json), side by side: the artist's deform skeleton, the
+   skeleton predicted with the defaults (the standard skeleton of the kind
+   the landmark network reads) and the free-form skeleton at
+   ``core.rigging.predict.DEFAULT_BANDWIDTH`` -> ``rigging_<Name>.png``.
 2. For one character (``--lod-character``, default the knight): the
-   prediction at :data:`BANDWIDTHS`, the network run once
+   free-form prediction at :data:`BANDWIDTHS`, the network run once
    -> ``rigging_bandwidths.png``.
 
 The mesh is see-through grey; joints are spheres and bones thin sticks from
@@ -33,7 +34,8 @@ from mathutils import Vector
 
 from autorig_addon.blender.characters import load_character
 from autorig_addon.core.geometry.bounding_box import largest_side
-from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, chosen_template, predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from docs_render import (
     CHARACTERS,
     DOC_CHARACTERS,
@@ -141,12 +143,15 @@ def render_panels(character, skeletons, path: str, out_dir: str) -> None:
 def render_comparison(path: str, out_dir: str) -> None:
     character, votes = character_and_votes(path)
     artist = character.skeleton.deform_subset()
-    predicted = skeleton_from_votes(votes, bandwidth=DEFAULT_BANDWIDTH)
+    standard = skeleton_from_votes(votes)
+    kind, note = chosen_template(votes)
+    free_form = skeleton_from_votes(votes, bandwidth=DEFAULT_BANDWIDTH, template=FREE_FORM)
     name = os.path.splitext(os.path.basename(path))[0]
-    print(f"{name}: artist {artist.bone_count} deform bones, predicted {predicted.bone_count} joints "
-          f"(bandwidth {DEFAULT_BANDWIDTH}); notes: {' '.join(votes.notes) or '-'}")
+    print(f"{name}: artist {artist.bone_count} deform bones, default ({kind}) {standard.bone_count} bones, "
+          f"free-form {free_form.bone_count} joints; {note} {' '.join(votes.notes)}")
     render_panels(character, [(f"artist\n{artist.bone_count} deform bones", artist),
-                              (f"predicted, bandwidth {DEFAULT_BANDWIDTH}\n{predicted.bone_count} joints", predicted)],
+                              (f"predicted ({kind} template)\n{standard.bone_count} bones", standard),
+                              (f"free-form, bandwidth {DEFAULT_BANDWIDTH}\n{free_form.bone_count} joints", free_form)],
                   os.path.join(out_dir, f"rigging_{name}.png"), out_dir)
 
 
@@ -154,7 +159,7 @@ def render_bandwidths(path: str, out_dir: str) -> None:
     character, votes = character_and_votes(path)
     skeletons = []
     for bandwidth in BANDWIDTHS:
-        skeleton = skeleton_from_votes(votes, bandwidth=bandwidth)
+        skeleton = skeleton_from_votes(votes, bandwidth=bandwidth, template=FREE_FORM)
         print(f"{os.path.basename(path)} at bandwidth {bandwidth}: {skeleton.bone_count} joints")
         skeletons.append((f"bandwidth {bandwidth}\n{skeleton.bone_count} joints", skeleton))
     render_panels(character, skeletons, os.path.join(out_dir, "rigging_bandwidths.png"), out_dir)

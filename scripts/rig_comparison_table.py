@@ -20,7 +20,7 @@ from skin_comparison_table import character_table, family_groups, format_cell, g
 
 METRICS = METRIC_KEYS["rig"]
 #: Metrics where higher is better; lower is better for the others.
-HIGHER_IS_BETTER = ("iou", "precision", "recall")
+HIGHER_IS_BETTER = ("iou", "precision", "recall", "key_joints", "key_joints_present")
 
 
 def main(paths) -> int:

@@ -34,7 +34,7 @@ from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict as rig_predict
 from autorig_addon.core.rigging.connectivity import bone_probabilities, root_scores
 from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth
-from autorig_addon.core.rigging.networks import joints
+from autorig_addon.core.rigging.networks import joints, landmarks
 from autorig_addon.core.rigging.tree_features import candidate_pairs, pair_features, root_features
 from autorig_addon.core.skinning.learned import predict as skin_predict
 from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
@@ -70,8 +70,9 @@ def skin_outputs() -> dict:
 
 
 def rig_outputs() -> dict:
-    """The joint network's ``joints.offsets`` (n, 3) and ``joints.attention``
-    (n,), then ``bones.probabilities`` and ``root.scores`` on the character's
+    """The landmark network's ``landmarks.points`` (15, 3) and
+    ``landmarks.kind_logits`` (1, 3), the joint network's ``joints.offsets``
+    (n, 3) and ``joints.attention`` (n,), then ``bones.probabilities`` and ``root.scores`` on the character's
     own joints (fixed inputs: joints a mean shift finds can move by more than
     the tolerance with the number of BLAS threads, which the predicted
     skeleton's record covers)."""
@@ -84,7 +85,10 @@ def rig_outputs() -> dict:
     found = sample.skeleton.joints
     mirror = np.full(len(found), -1)  # no twins: a fixed input is all this needs
     pairs = candidate_pairs(found)
+    points, kind_logits = landmarks.SPEC.forward(NUMPY, shipped_weights(landmarks.SPEC).weights, graph)
     return {
+        "landmarks.points": np.asarray(points, dtype=np.float32),
+        "landmarks.kind_logits": np.asarray(kind_logits, dtype=np.float32),
         "joints.offsets": offsets.astype(np.float32),
         "joints.attention": sigmoid(logits).astype(np.float32),
         "bones.probabilities": bone_probabilities(pair_features(found, pairs, solid, mirror)).astype(np.float32),

@@ -91,7 +91,7 @@ def test_help_lists_every_subcommand_without_loading_blender(repository_root):
     )
     assert result.returncode == 0, result.stderr
     text = " ".join(result.stdout.split())
-    assert list(SUBCOMMANDS) == ["transfer", "skin", "rig", "eval", "package", "train"]
+    assert list(SUBCOMMANDS) == ["transfer", "skin", "rig", "rename", "eval", "package", "train"]
     for name, subcommand in SUBCOMMANDS.items():
         assert f"{name} {subcommand.help}" in text
 

@@ -279,7 +279,8 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
     [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'heterskinnet', "
                        "'nearest_bone', 'rignet', 'skinningnet', 'reference']."),
      ("rig", "file:/no/such/folder", "The folder of predicted rigs '/no/such/folder' does not exist."),
-     ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of ['nearest_character', 'rignet']."),
+     ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of ['nearest_character', 'rignet', "
+                       "'rignet_free_form']."),
      ("transfer", "copy", "Unknown transfer method 'copy': use one of ['closest_point', 'robust'].")],
 )
 def test_unknown_methods_are_usage_errors(task, method, message, tmp_path, capsys):

@@ -86,7 +86,7 @@ def random_inputs(name, seed):
     if name in SKIN_NETWORKS:
         bone_count = (1, 3, 9)[seed % 3]
         return skin_graph(*random_skin_inputs(seed, 40 + bone_count, bone_count))
-    if name == "joints":
+    if name in ("joints", "landmarks"):
         return random_joint_graph(seed)
     return rng.normal(size=(300, PAIR_FEATURES if name == "bones" else ROOT_FEATURES)).astype(np.float32)
 
@@ -102,7 +102,8 @@ def procedural_inputs():
     solid = solid_depth(sample.mesh, RESOLUTION)
     joints = reference_skeleton(sample).joints
     inputs = {name: skin[spec.distance] for name, spec in SKIN_NETWORKS.items()}
-    inputs.update(joints=joint_graph(sample.mesh, solid),
+    graph = joint_graph(sample.mesh, solid)
+    inputs.update(joints=graph, landmarks=graph,
                   bones=pair_features(joints, candidate_pairs(joints), solid, np.full(len(joints), -1)),
                   root=root_features(joints, solid))
     return inputs

@@ -10,6 +10,7 @@ from autorig_addon.core.nn.convolution import edge_convolution, edge_messages, m
 from autorig_addon.core.nn.layers import mlp, standardised
 from autorig_addon.core.nn.numpy_kernels import (
     NUMPY,
+    column_softmax,
     gather,
     leaky_relu,
     linear,
@@ -76,6 +77,12 @@ def test_masked_row_softmax_scatter_and_sigmoid_by_hand():
     np.testing.assert_allclose(masked_row_softmax(logits, valid), [[0.25, 0.75, 0], [1, 0, 0]], rtol=1e-12)
     assert scatter(np.array([4.0, 5.0]), np.array([3, 0]), 4).tolist() == [5, 0, 0, 4]
     np.testing.assert_allclose(sigmoid(np.array([0.0, np.log(3.0), -800.0])), [0.5, 0.75, 0.0], atol=1e-15)
+
+
+def test_column_softmax_by_hand():
+    # Each column over its rows: exp = 1 and 3 give 0.25 and 0.75; a shift of 1000 changes nothing.
+    logits = np.log([[1.0, 2.0], [3.0, 2.0]]) + np.array([1000.0, -5.0])
+    np.testing.assert_allclose(column_softmax(logits), [[0.25, 0.5], [0.75, 0.5]], rtol=1e-12)
 
 
 def test_gather_and_edge_messages():

@@ -126,6 +126,7 @@ def test_the_other_kernels_agree():
         "nonzero": (lambda ops: ops.nonzero(*tensors_for(ops, mask.reshape(-1)))),
         "scatter": (lambda ops: ops.scatter(*tensors_for(ops, x[:4, 0], np.array([9, 2, 5, 0])), 12)),
         "masked row softmax": (lambda ops: ops.masked_row_softmax(*tensors_for(ops, 30 * x, valid))),
+        "column softmax": (lambda ops: ops.column_softmax(*tensors_for(ops, 30 * x))),
         **{f"activation {name}": (lambda ops, name=name: ops.activations[name](*tensors_for(ops, x)))
            for name in NUMPY.activations},
     }

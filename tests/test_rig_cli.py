@@ -129,3 +129,54 @@ def test_bad_arguments_exit_2_with_the_reason(arguments, message, capsys):
     code, out, err = run_main(arguments, capsys)
     assert code == 2 and out == ""
     assert message in err
+
+
+def test_a_standard_biped_with_mixamo_names_then_renamed_to_unreal(clean_scene, tmp_path, capsys):
+    source, out, renamed = tmp_path / "hero.glb", tmp_path / "hero.blend", tmp_path / "hero_unreal.blend"
+    save_biped(source)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--template", "biped", "--names", "mixamo",
+                                "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["rigify"], item["bones"]) == ("biped", False, 22)
+    assert item["body"] in ("biped", "quadruped", "other") and 0.0 <= item["confidence"] <= 1.0
+    armature, mesh = the_armature_and_mesh(out)
+    assert {"mixamorig:Hips", "mixamorig:LeftArm", "mixamorig:RightToeBase"} <= set(armature.data.bones.keys())
+    assert "mixamorig:LeftUpLeg" in mesh.vertex_groups
+
+    code, stdout, _ = run_main(["rename", str(out), "--out", str(renamed), "--names", "unreal", "--quiet"], capsys)
+
+    assert code == 0 and json.loads(stdout)["succeeded"][0]["renamed"] == 22
+    armature, mesh = the_armature_and_mesh(renamed)
+    assert {"pelvis", "upperarm_l", "ball_r"} <= set(armature.data.bones.keys())
+    assert "thigh_l" in mesh.vertex_groups and "mixamorig:LeftUpLeg" not in mesh.vertex_groups
+
+
+def test_rigify_builds_the_control_rig_and_binds_to_its_def_bones(clean_scene, tmp_path, capsys):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--template", "biped", "--rigify",
+                                "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert item["rigify"] is True and item["armature"] == "hero_rig"
+    objects = objects_of(out)
+    rig, mesh = objects["hero_rig"], objects["Biped"]
+    assert objects["hero_rig_metarig"].type == "ARMATURE"
+    assert [(m.type, m.object) for m in mesh.modifiers] == [("ARMATURE", rig)]
+    assert {group.name for group in mesh.vertex_groups} <= {b.name for b in rig.data.bones if b.use_deform}
+    assert "DEF-forearm.L" in mesh.vertex_groups
+
+
+def test_rigify_with_the_free_form_template_is_refused(clean_scene, tmp_path, capsys):
+    source = tmp_path / "hero.glb"
+    save_biped(source)
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(tmp_path / "o.blend"), "--template", "free-form",
+                                "--rigify", "--quiet"], capsys)
+    assert code == 1
+    assert json.loads(stdout)["failed"][0]["error"] == ("Rigify needs a standard skeleton: choose the Auto, Biped or "
+                                                       "Quadruped template.")

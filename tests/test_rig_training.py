@@ -9,12 +9,20 @@ import pytest
 from autorig_addon.core.nn.spec import shipped_weights
 from autorig_addon.core.nn.weights_io import load_weights
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
-from autorig_addon.training.rigging.training_set import sample_examples
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.training.rigging.training_set import reference_skeleton, sample_examples
 from geometry_fixtures import procedural_sample
 
 torch = pytest.importorskip("torch")
 pytestmark = pytest.mark.torch
 
+from autorig_addon.training.rigging.landmarks import (  # noqa: E402
+    MIRRORED,
+    holdout_scores,
+    landmark_data,
+    sample_landmarks,
+    train_landmark_network,
+)
 from autorig_addon.training.rigging.train import (  # noqa: E402
     JITTER_COPIES,
     connectivity_data,
@@ -88,3 +96,38 @@ def test_written_weights_are_what_the_predictor_reads(examples, tmp_path):
     # The shipped weights are untouched by a run written elsewhere.
     assert not np.array_equal(shipped_weights(RIG_NETWORKS["root"]).weights["mlp.linears.0.weight"],
                               weights["mlp.linears.0.weight"])
+
+
+def test_a_landmark_network_run_reproduces_and_scores_its_kept_epoch(examples):
+    samples = {f"procedural_{seed}": procedural_sample(seed) for seed in (4, 5, 8)}
+    train, holdout = examples
+
+    def landmark_run():
+        record = start_run(RIG_NETWORKS["landmarks"], seed=3, device="cpu", epochs=2, learning_rate=None,
+                           score_name="landmark_error")
+        return train_landmark_network(samples, train, holdout, record), record
+
+    first, record = landmark_run()
+    second, _ = landmark_run()
+    assert all(np.array_equal(first[name], second[name]) for name in first)
+    errors = [entry["landmark_error"] for entry in record.history]
+    assert record.best_score == min(errors) and len(errors) == 3
+    again = holdout_scores(RIG_NETWORKS["landmarks"], first, landmark_data(samples, holdout))
+    assert again["landmark_error"] == pytest.approx(record.best_score, abs=1e-12)
+    RIG_NETWORKS["landmarks"].check_weights(first, "the run")
+
+
+def test_landmark_targets_follow_a_stretched_variant_and_mirroring_swaps_sides():
+    sample = procedural_sample(5)
+    original, variant = sample_examples(sample, np.random.default_rng(0), variants=1)
+    targets, known, kind = sample_landmarks(sample)
+    (_, same, _, _), (_, moved, _, _) = landmark_data({sample.name: sample}, [original, variant])
+    np.testing.assert_allclose(same[known > 0], targets[known > 0], atol=1e-5)
+    # The variant's joints are the character's stretched per axis: so are its landmarks, to float precision.
+    source = reference_skeleton(sample).joints
+    scale = np.ptp(variant.joints, axis=0) / np.ptp(source, axis=0)
+    shift = variant.joints.min(axis=0) - scale * source.min(axis=0)
+    np.testing.assert_allclose(moved[known > 0], (scale * targets + shift)[known > 0], atol=1e-5)
+    # Mirroring swaps each left landmark with its right twin and keeps the midline ones.
+    assert [LANDMARKS[index] for index in MIRRORED[:4]] == ["hips", "neck", "head", "shoulder.R"]
+    assert sorted(MIRRORED.tolist()) == list(range(len(LANDMARKS)))

@@ -18,6 +18,7 @@ from autorig_addon.core.geometry.bounding_box import largest_side
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import connectivity, mean_shift, predict, symmetry, tree_features
 from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
+from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
 from autorig_addon.core.types import Mesh, Skeleton
 from autorig_addon.training.rigging.training_set import joint_targets
@@ -431,7 +432,7 @@ def biped_votes(biped):
 
 @pytest.fixture(scope="module")
 def biped_skeleton(biped_votes):
-    return predict.skeleton_from_votes(biped_votes)
+    return predict.skeleton_from_votes(biped_votes, template=FREE_FORM)
 
 
 def mirror_plane_x(mesh):
@@ -483,7 +484,7 @@ def test_the_predicted_hierarchy_is_mirrored(biped_skeleton):
 
 
 def test_predict_skeleton_is_predict_votes_then_skeleton_from_votes(biped, biped_skeleton):
-    skeleton = predict.predict_skeleton(biped[0])
+    skeleton = predict.predict_skeleton(biped[0], template=FREE_FORM)
     assert skeleton.names == biped_skeleton.names
     np.testing.assert_array_equal(skeleton.parents, biped_skeleton.parents)
     np.testing.assert_allclose(skeleton.joints, biped_skeleton.joints, atol=1e-9)
@@ -504,7 +505,7 @@ def test_a_larger_bandwidth_gives_no_more_joints(biped_votes, biped_skeleton):
     # Measured: 38 joints at the default 0.02, then 11, 6, 3 and 1.
     counts = [biped_skeleton.bone_count]
     for bandwidth in COARSER_BANDWIDTHS:
-        skeleton = predict.skeleton_from_votes(biped_votes, bandwidth=bandwidth)
+        skeleton = predict.skeleton_from_votes(biped_votes, bandwidth=bandwidth, template=FREE_FORM)
         assert len(set(skeleton.names)) == skeleton.bone_count
         counts.append(skeleton.bone_count)
     assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1], counts
@@ -512,7 +513,7 @@ def test_a_larger_bandwidth_gives_no_more_joints(biped_votes, biped_skeleton):
 
 def test_skeleton_from_votes_without_symmetry(biped, biped_votes):
     mesh, reference = biped
-    skeleton = predict.skeleton_from_votes(biped_votes, symmetry=False)
+    skeleton = predict.skeleton_from_votes(biped_votes, symmetry=False, template=FREE_FORM)
     assert_well_formed(skeleton, mesh)
     # No twins were paired: no name says a side.
     assert not any(name.endswith((LEFT_SUFFIX, RIGHT_SUFFIX)) for name in skeleton.names)
@@ -530,7 +531,7 @@ BANDWIDTH_RANGE = f"between {predict.MIN_BANDWIDTH} and {predict.MAX_BANDWIDTH}"
 ])
 def test_out_of_range_settings_are_refused(biped_votes, bandwidth, threshold, message):
     with pytest.raises(InputError) as raised:
-        predict.skeleton_from_votes(biped_votes, bandwidth=bandwidth, density_threshold=threshold)
+        predict.skeleton_from_votes(biped_votes, bandwidth=bandwidth, density_threshold=threshold, template=FREE_FORM)
     assert str(raised.value) == message
 
 
@@ -575,7 +576,7 @@ def turned_prediction(direction: int):
     character = generate_character(BIPED_SEED, "biped")
     mesh = Mesh(placed(character.mesh.vertices, rotation), character.mesh.triangles)
     votes = predict.predict_votes(mesh)
-    return rotation, mesh, votes, predict.skeleton_from_votes(votes)
+    return rotation, mesh, votes, predict.skeleton_from_votes(votes, template=FREE_FORM)
 
 
 @pytest.mark.parametrize("direction", [FACING_PLUS_X, FACING_MINUS_X], ids=["facing +X", "facing -X"])

@@ -36,7 +36,8 @@ def test_every_skin_network_gives_its_recorded_candidates_and_weights(recorded):
 
 def test_the_skeleton_networks_give_their_recorded_outputs(recorded):
     now = rig_outputs()
-    assert sorted(now) == ["bones.probabilities", "joints.attention", "joints.offsets", "root.scores"]
+    assert sorted(now) == ["bones.probabilities", "joints.attention", "joints.offsets", "landmarks.kind_logits",
+                           "landmarks.points", "root.scores"]
     assert_same_arrays(now, recorded, OUTPUT_TOLERANCE)
 
 

@@ -14,7 +14,7 @@ import bpy
 #: Modules with a ``classes`` tuple, in registration order (property groups
 #: before the operators and panels that use them).
 _MODULE_NAMES = ("ui.properties", "operators.transfer", "operators.skin", "operators.rignet", "operators.rig",
-                 "ui.panels")
+                 "operators.bone_names", "ui.panels")
 
 
 def _modules():

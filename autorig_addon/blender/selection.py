@@ -229,19 +229,23 @@ def resolve_skin_inputs(context, armature_name: str = "", mesh_names: str = ""):
     return armature, meshes
 
 
+def file_armature(armature_name: str = ""):
+    """The armature of a loaded file a command works on: the named one, else the file's only armature."""
+    if armature_name:
+        return find_object(armature_name, "ARMATURE")
+    armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+    if len(armatures) != 1:
+        found = ", ".join(obj.name for obj in armatures) or "none"
+        raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
+    return armatures[0]
+
+
 def skin_objects(armature_name: str, mesh_names: list[str]):
     """The armature and meshes a skin run binds in a loaded file: the named
     ones (``mesh_names``: repeated or comma-separated names), else the
     file's only armature and every mesh (the job leaves out helpers such as
     bone shapes and leaves props parented to a bone rigid)."""
-    if armature_name:
-        armature = find_object(armature_name, "ARMATURE")
-    else:
-        armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
-        if len(armatures) != 1:
-            found = ", ".join(obj.name for obj in armatures) or "none"
-            raise InputError(f"The file must hold exactly one armature, or name it with --armature (found: {found}).")
-        armature = armatures[0]
+    armature = file_armature(armature_name)
     names = names_in(mesh_names)
     if names:
         return armature, [find_object(name, "MESH") for name in names]

@@ -221,11 +221,12 @@ def _nearest_character(mesh) -> RigPrediction:
     return RigPrediction(chosen.skeleton, (chosen.note,))
 
 
-def _rignet_skeleton(mesh) -> RigPrediction:
-    from ..core.rigging.predict import predict_votes, skeleton_from_votes
+def _rignet_skeleton(mesh, template: str = "auto") -> RigPrediction:
+    from ..core.rigging.predict import chosen_template, predict_votes, skeleton_from_votes
 
     votes = predict_votes(mesh)
-    return RigPrediction(skeleton_from_votes(votes), votes.notes)
+    return RigPrediction(skeleton_from_votes(votes, template=template),
+                         (*votes.notes, chosen_template(votes, template)[1]))
 
 
 def _closest_point_transfer(source, source_weights, target):
@@ -254,6 +255,10 @@ register_rig_method(
     "rignet", _rignet_skeleton,
     "the skeleton predictor with its defaults: joint network, mean shift, bone and root networks "
     "(core.rigging.predict)",
+)
+register_rig_method(
+    "rignet_free_form", lambda mesh: _rignet_skeleton(mesh, "free-form"),
+    "the skeleton predictor's free-form skeleton (template free-form): the joint votes' skeleton whatever the body",
 )
 register_transfer_method("robust", _robust_transfer, "robust transfer with inpainting (core.transfer)")
 register_transfer_method("closest_point", _closest_point_transfer, "weights of the closest surface point")

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..core.errors import InputError
-from . import evaluate, package, rig, skin, transfer
+from . import evaluate, package, rename, rig, skin, transfer
 from .exit_codes import EXIT_FAILED, EXIT_USAGE, UsageError
 
 
@@ -48,7 +48,7 @@ def register_subcommand(name: str, help: str, add_arguments, run) -> None:
 #: training package, which a source checkout has and the extension zip leaves out.
 TRAINING_PACKAGE, TRAINING_COMMAND = "..training", "..training.command"
 
-_modules = [transfer, skin, rig, evaluate, package]
+_modules = [transfer, skin, rig, rename, evaluate, package]
 if importlib.util.find_spec(TRAINING_PACKAGE, __package__) is not None:
     _modules.append(importlib.import_module(TRAINING_COMMAND, __package__))
 for _module in _modules:

@@ -36,6 +36,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"How the meshes are weighted to the new skeleton ({NO_SKIN}: the armature alone, meshes unbound; "
              f"default {DEFAULT_SKIN_METHOD}; see the skin subcommand)",
     )
+    parser.add_argument("--rigify", action="store_true",
+                        help="Build Rigify's control rig (IK/FK limbs, torso and head controls) from the standard "
+                             "skeleton and bind the meshes to its DEF- bones (needs a biped or quadruped: the "
+                             "template auto recognising one, or --template biped/quadruped); the metarig stays in "
+                             "the file, hidden")
     parser.add_argument("--replace", action="store_true",
                         help="Rig a file that already holds an armature: remove it, the meshes' Armature modifiers "
                              "and their groups named after its bones first (default: such a file is refused)")
@@ -72,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     from ..blender.jobs.skin import SkinSettings
     from ..core.skinning.options import SkinningOptions
 
-    settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry)
+    settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry, args.template, args.names)
     skin = None if args.skin == NO_SKIN else SkinSettings(SkinningOptions(method=args.skin))
 
     def process(input_path, output_path, progress):
@@ -89,12 +94,13 @@ def run(args: argparse.Namespace) -> int:
         if not meshes:
             raise InputError("The file holds no mesh to rig.")
         plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), Path(input_path).stem, settings,
-                        skin=skin, named=False)
+                        skin=skin, named=False, rigify=args.rigify)
         result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)
         details = {"armature": result.armature.name, "bones": result.skeleton.bone_count,
-                   "meshes": [obj.name for obj in plan.meshes], "skin": args.skin}
+                   "meshes": [obj.name for obj in plan.meshes], "skin": args.skin, "template": result.template,
+                   "body": result.body, "confidence": round(result.confidence, 3), "rigify": result.rigify}
         if removed:
             details["replaced"] = removed
         notes = list(result.notes) + (result.skin_plan.notes if result.skin_plan is not None else [])

@@ -37,12 +37,14 @@ from ...core.errors import InputError
 from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
-from ...core.rigging.predict import JointVotes, predict_votes, skeleton_from_votes
+from ...core.rigging.predict import JointVotes, chosen_template, naming_note, predict_votes, skeleton_from_votes
+from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
 from ...core.types import Mesh, Skeleton
 from .. import convert
 from ..armature_binding import armature_bindings, bound_armature, deforms, followers, remove_armature, unbind
 from ..armature_builder import build_armature
+from ..rigify_rig import generate_rigify_rig
 from ..snapshot import restored_on_failure
 from .input_checks import check_mode
 from .skin import SkinSettings, compute_skin, plan_skin, write_skin
@@ -73,15 +75,23 @@ class RigSettings:
     bandwidth : float or None, mean-shift bandwidth as a share of the character's largest side
     density_threshold : float or None, share of the strongest mode's vote mass below which a mode is dropped
     symmetry : bool or None, mirror votes and pair joints when the shape is left-right symmetric
+    template : str or None, ``auto``, ``biped``, ``quadruped`` or ``free-form``
+    names : str or None, a bone-name preset of ``core.skeleton.name_presets.PRESETS``
     """
 
     bandwidth: float | None = None
     density_threshold: float | None = None
     symmetry: bool | None = None
+    template: str | None = None
+    names: str | None = None
 
     def keywords(self) -> dict:
         """The keyword arguments of ``skeleton_from_votes`` that were given."""
         return {name: value for name, value in vars(self).items() if value is not None}
+
+
+def _template(settings: RigSettings) -> dict:
+    return {"template": settings.template} if settings.template is not None else {}
 
 
 @dataclass
@@ -98,6 +108,7 @@ class RigPlan:
     replace : bool, unbind meshes already bound to an armature before binding them, and remove
         that armature afterwards when nothing else follows it
     named : bool, the user picked the meshes (False: every mesh of a file; see ``plan_skin``)
+    rigify : bool, turn the standard skeleton into Rigify's control rig and bind the meshes to its DEF- bones
     """
 
     meshes: list
@@ -107,18 +118,26 @@ class RigPlan:
     skin: SkinSettings | None = None
     replace: bool = False
     named: bool = True
+    rigify: bool = False
 
 
 @dataclass
 class RigResult:
     """What a run built: the armature, its skeleton, the notes of the
-    prediction and, when it bound the meshes, the skin plan and weights."""
+    prediction and, when it bound the meshes, the skin plan and weights;
+    ``template`` is the skeleton built (``biped``, ``quadruped`` or
+    ``free-form``), ``body`` and ``confidence`` what the landmark network
+    read the body as and how sure it was, ``rigify`` whether Rigify's control rig was generated."""
 
     armature: object
     skeleton: Skeleton
     notes: tuple = ()
     skin_plan: object = None
     weights: object = None
+    template: str = ""
+    body: str = ""
+    confidence: float = 0.0
+    rigify: bool = False
 
 
 @dataclass
@@ -134,7 +153,8 @@ _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
 
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
-             skin: SkinSettings | None = None, replace: bool = False, named: bool = True) -> RigPlan:
+             skin: SkinSettings | None = None, replace: bool = False, named: bool = True,
+             rigify: bool = False) -> RigPlan:
     """Read and check the character's meshes; raises :class:`InputError` on bad input.
 
     Parameters
@@ -146,7 +166,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     skin : SkinSettings or None; given, the meshes are bound, and a mesh
         already bound to an armature is refused unless ``replace``
     replace : bool
-    named : bool, see :class:`RigPlan`
+    named, rigify : bool, see :class:`RigPlan`
     """
     meshes = list(dict.fromkeys(meshes))
     if not meshes:
@@ -164,7 +184,9 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
             )
     mesh = convert.read_mesh(meshes, depsgraph)
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named)
+    if rigify and settings.template == FREE_FORM:
+        raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
+    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify)
 
 
 def _remember(armature, votes: JointVotes) -> None:
@@ -195,24 +217,49 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
     replaced = _followed_armatures(plan.meshes) if plan.skin is not None and plan.replace else []
     armature = build_armature(skeleton, plan.name, context)
+    created = [armature]
     try:
         armature.show_in_front = True  # the bones are inside the body
-        result = RigResult(armature, skeleton, votes.notes)
+        template, template_note = chosen_template(votes, **_template(plan.settings))
+        notes = (*votes.notes, template_note)
+        if plan.settings.names is not None and naming_note(skeleton, plan.settings.names):
+            notes = (*notes, naming_note(skeleton, plan.settings.names))
+        target = armature
+        rig = None
+        if plan.rigify:
+            try:
+                rig, metarig, rigify_notes = generate_rigify_rig(armature, plan.name, context)
+            except InputError as error:
+                # The standard skeleton is still a usable rig: keep it, and say why there is no control rig.
+                notes = (*notes, f"no Rigify control rig: {error}")
+            else:
+                created += [rig, metarig]
+                target, notes = rig, (*notes, *rigify_notes)
+        result = RigResult(target, convert.read_skeleton(target) if rig is not None else skeleton, notes,
+                           template=template, rigify=rig is not None)
+        if votes.landmarks is not None:
+            result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
         if plan.skin is not None:
             with restored_on_failure(plan.meshes):
                 if plan.replace:
                     for obj in plan.meshes:
                         unbind(obj)
-                skin_plan = plan_skin(armature, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
+                skin_plan = plan_skin(target, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
                                       named=plan.named)
                 weights = yield lambda progress: compute_skin(skin_plan, sub_progress(progress, share, 1.0))
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights
-        if remember:
+        if remember and rig is None:
             _remember(armature, votes)
     except BaseException:
-        remove_armature(armature)
+        for obj in reversed(created):
+            if obj.name in bpy.data.objects:
+                remove_armature(obj)
         raise
+    if rig is not None:
+        # The predicted skeleton lives on as the metarig: keep one armature by the character's name.
+        remove_armature(armature)
+        rig.name = rig.data.name = plan.name
     # Last, once nothing can fail: a removed armature cannot be restored.
     result.notes = (*result.notes, *_remove_unused(replaced))
     return result

@@ -9,7 +9,7 @@ from __future__ import annotations
 import bpy
 
 from ...core.errors import Cancelled, InputError
-from ...core.rigging.options import REPLACE_BINDING
+from ...core.rigging.options import REPLACE_BINDING, RIGIFY
 from ..jobs.input_checks import mode_poll
 from ..jobs.rig import RigPlan, RigResult, TaskJob, plan_rig, rig_steps, run_steps
 from ..jobs.skin import SkinSettings
@@ -55,7 +55,8 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
         meshes = selected_meshes(context)
         name = character_name(meshes, context.active_object) if meshes else ""
         return plan_rig(meshes, context.evaluated_depsgraph_get(), name, rig_settings_from(self),
-                        skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)))
+                        skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)),
+                        rigify=bool(getattr(self, "rig_rigify", False)))
 
     def invoke(self, context, event):
         for name, value in scene_values(context, self.option_names(), self.properties.is_property_set).items():
@@ -151,9 +152,10 @@ class AUTORIG_OT_auto_rig(_RigOperator, SkinOptionProperties, bpy.types.Operator
     bl_label = "Auto-Rig"
 
     rig_replace: option_property(REPLACE_BINDING)
+    rig_rigify: option_property(RIGIFY)
 
     def option_names(self) -> tuple:
-        return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace",)
+        return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace", "rig_rigify")
 
     def skin_settings(self) -> SkinSettings:
         return skin_settings_from(self)

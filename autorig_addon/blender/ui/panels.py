@@ -4,6 +4,7 @@ import bpy
 
 from ...core.skinning.methods import GEOMETRIC
 from ..jobs.rig import live_note
+from ..operators.bone_names import AUTORIG_OT_rename_bones
 from ..operators.rig import AUTORIG_OT_auto_rig, AUTORIG_OT_predict_skeleton
 from ..operators.skin import AUTORIG_OT_skin_weights
 from ..operators.transfer import AUTORIG_OT_create_transfer_mask, AUTORIG_OT_transfer_weights
@@ -146,9 +147,14 @@ class VIEW3D_PT_autorig_rig(_AutoRigSubPanel, bpy.types.Panel):
         else:
             column.label(text="Select the character's mesh(es)", icon="INFO")
 
+        layout.prop(settings, "rig_template")
+        layout.prop(settings, "rig_names")
         column = layout.column(align=True)
-        column.prop(settings, "rig_bandwidth")
-        column.prop(settings, "rig_density_threshold")
+        detail = column.column(align=True)
+        # The clustering shapes only the free-form skeleton (a standard one has its fixed bones).
+        detail.active = settings.rig_template in ("AUTO", "FREE-FORM")
+        detail.prop(settings, "rig_bandwidth")
+        detail.prop(settings, "rig_density_threshold")
         column.prop(settings, "rig_symmetry")
         note, icon = live_note(context)
         if note:
@@ -158,7 +164,11 @@ class VIEW3D_PT_autorig_rig(_AutoRigSubPanel, bpy.types.Panel):
         layout.operator(AUTORIG_OT_skin_weights.bl_idname, text="Skin", icon="MOD_ARMATURE")
         column = layout.column(align=True)
         column.prop(settings, "rig_replace")
+        column.prop(settings, "rig_rigify")
         column.operator(AUTORIG_OT_auto_rig.bl_idname, icon="OUTLINER_OB_ARMATURE")
+        generate = column.operator(AUTORIG_OT_auto_rig.bl_idname, text="Generate Rigify Rig", icon="POSE_HLT")
+        generate.rig_rigify = True
+        layout.operator_menu_enum(AUTORIG_OT_rename_bones.bl_idname, "preset", text="Rename Bones", icon="SORTALPHA")
 
 
 classes = (VIEW3D_PT_autorig, VIEW3D_PT_autorig_rig, VIEW3D_PT_autorig_transfer, VIEW3D_PT_autorig_skin)

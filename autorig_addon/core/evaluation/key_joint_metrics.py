@@ -56,10 +56,11 @@ def score_key_joints(predicted: Skeleton, mesh: Mesh, reference: Skeleton, size:
     normalised frame (:func:`~..dataset.normalise.normalise`).
     """
     left = np.linalg.inv(normalise(mesh, reference).transform)[:3, 0]
-    truth = key_joints(reference.names, reference.joints, left_direction=left)
+    truth = key_joints(reference.names, reference.joints, left_direction=left, parents=reference.parents)
     if not any(role.endswith((LEFT, RIGHT)) for role in truth.positions):
         return {}
-    scores = key_joint_score(key_joints(predicted.names, predicted.joints), truth, KEY_JOINT_FRACTION * size)
+    found = key_joints(predicted.names, predicted.joints, parents=predicted.parents)
+    scores = key_joint_score(found, truth, KEY_JOINT_FRACTION * size)
     return {"key_joints": scores["key_joints"], "key_joints_present": scores["key_joints_present"],
             "key_joint_count": scores["key_joint_count"], "key_joint_errors": {
                 role: (None if error is None else round(error / size, 4))

@@ -161,11 +161,18 @@ def masked_row_softmax(logits: np.ndarray, valid: np.ndarray) -> np.ndarray:
 ACTIVATIONS = {"relu": relu, "leaky_relu": leaky_relu, "none": identity}
 
 #: The numpy operations table (:class:`~.operations.Operations`).
+def column_softmax(logits: np.ndarray) -> np.ndarray:
+    """Softmax of each column over its rows; the column maximum is
+    subtracted first so that large logits do not overflow."""
+    exponentials = np.exp(logits - logits.max(axis=0, keepdims=True))
+    return exponentials / exponentials.sum(axis=0, keepdims=True)
+
+
 NUMPY = Operations(
     name="numpy", concat=concat, column_max=column_max, repeat_rows=repeat_rows, gather=gather,
     segment_sum=segment_sum, segment_mean=segment_mean, segment_max=segment_max, segment_min=segment_min,
     linear=linear, activations=ACTIVATIONS, log=np.log, sqrt=np.sqrt, clamp_min=clamp_min, where=where,
-    nonzero=nonzero, scatter=scatter, masked_row_softmax=masked_row_softmax,
+    nonzero=nonzero, scatter=scatter, masked_row_softmax=masked_row_softmax, column_softmax=column_softmax,
 )
 
 

@@ -53,6 +53,8 @@ class Operations:
     scatter : ((p,), (p,) int, m) -> (m,), the values at those indices of zeros
     masked_row_softmax : ((n, k), (n, k) bool) -> (n, k), softmax of each
         row over its valid entries (0 at the others); a row needs one valid entry
+    column_softmax : (n, k) -> (n, k), softmax of each column over its rows
+        (weights over the vertices, one column per landmark)
     """
 
     name: str
@@ -73,3 +75,4 @@ class Operations:
     nonzero: Callable[[Array], Array]
     scatter: Callable[[Array, Array, int], Array]
     masked_row_softmax: Callable[[Array, Array], Array]
+    column_softmax: Callable[[Array], Array]

@@ -1,7 +1,8 @@
 """Options of skeleton prediction: the clustering that turns the joint
 votes into a skeleton (:data:`RIG_OPTIONS`, the keywords of
 :func:`.predict.skeleton_from_votes`) and what Auto-Rig does with meshes
-already bound (:data:`REPLACE_BINDING`). The Rig panel, the Predict
+already bound (:data:`REPLACE_BINDING`) and whether it builds Rigify's
+control rig (:data:`RIGIFY`). The Rig panel, the Predict
 Skeleton and Auto-Rig operators and ``python -m autorig_addon rig`` are
 made from them (``core.options``); defaults and bounds are
 :mod:`.predict`'s.
@@ -9,8 +10,9 @@ made from them (``core.options``); defaults and bounds are
 
 from __future__ import annotations
 
-from ..options import FRACTION, Option, option_table
-from . import predict
+from ..options import FRACTION, Choice, Option, option_table
+from ..skeleton import name_presets
+from . import predict, standard_skeleton
 
 #: The clustering options, in the panel's order; the panel re-clusters the
 #: predicted armature live when one changes.
@@ -26,6 +28,22 @@ RIG_OPTIONS = option_table(
     Option("symmetry", bool, predict.DEFAULT_SYMMETRY, "Symmetry",
            "When the character is left-right symmetric, mirror the joint votes and pair the joints, so the "
            "skeleton is symmetric with .L/.R names"),
+    Option("template", str, predict.DEFAULT_TEMPLATE, "Template",
+           "Which skeleton to build: a standard biped or quadruped (Rigify's metarig layout and names), the "
+           "free-form skeleton of the joint votes, or whichever the shape looks like",
+           choices=(
+               Choice(standard_skeleton.AUTO, "Auto", "A standard biped or quadruped skeleton when the shape "
+                      "clearly is one, otherwise the free-form skeleton"),
+               Choice(standard_skeleton.BIPED, "Biped", "A standard humanoid skeleton (Rigify's human metarig)"),
+               Choice(standard_skeleton.QUADRUPED, "Quadruped",
+                      "A standard four-legged skeleton (Rigify's quadruped metarig)"),
+               Choice(standard_skeleton.FREE_FORM, "Free-Form",
+                      "The skeleton of the joint votes, any shape; the bandwidth sets its detail"))),
+    Option("names", str, name_presets.DEFAULT_PRESET, "Bone Names",
+           "How the bones of a standard biped are named: Blender's Rigify, or a game engine's or mocap library's "
+           "humanoid names (other skeletons keep Rigify's names)",
+           choices=tuple(Choice(preset, label.split(" (")[0], label) for preset, label in
+                         name_presets.PRESET_LABELS.items())),
 )
 
 #: Auto-Rig's choice for meshes already bound to an armature (the panel's and
@@ -35,4 +53,12 @@ REPLACE_BINDING = Option(
     "replace", bool, False, "Replace Binding",
     "Meshes already bound to an armature lose that binding (its Armature modifier and bone groups) and are bound "
     "to the new skeleton, and the old armature is removed when nothing else follows it; otherwise they are refused",
+    flag=None)
+
+#: Auto-Rig's Rigify choice (the panel's and the operator's; the ``rig``
+#: command's ``--rigify``).
+RIGIFY = Option(
+    "rigify", bool, False, "Rigify Control Rig",
+    "Build Rigify's control rig (IK/FK limbs, torso and head controls) from the standard skeleton and bind the "
+    "meshes to its DEF- bones; needs the Biped or Quadruped template (or Auto recognising one)",
     flag=None)

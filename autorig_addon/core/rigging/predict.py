@@ -33,6 +33,7 @@ from ..geometry.proxy import simplified_proxy
 from ..nn.numpy_kernels import NUMPY, sigmoid
 from ..nn.spec import shipped_weights
 from ..progress import ProgressCallback, report
+from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
@@ -40,6 +41,15 @@ from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph,
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .role_names import role_names
+from .standard_skeleton import (
+    AUTO,
+    FREE_FORM,
+    KIND_CONFIDENCE,
+    TEMPLATES,
+    Landmarks,
+    predict_landmarks,
+    standard_skeleton,
+)
 from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
 
@@ -62,6 +72,11 @@ MIN_DENSITY_THRESHOLD = 0.0
 MAX_DENSITY_THRESHOLD = 1.0
 #: Mirror votes and pair joints when the shape is left-right symmetric.
 DEFAULT_SYMMETRY = True
+#: The skeleton's template: the landmark network's guess of the body
+#: (:func:`chosen_template`).
+DEFAULT_TEMPLATE = AUTO
+#: Kinds of body that have a standard skeleton.
+STANDARD_KINDS = ("biped", "quadruped")
 #: Joints this close to the mirror plane, or to their twin's mirror image,
 #: are snapped (share of the bandwidth).
 SNAP_SHARE = 0.5
@@ -93,6 +108,9 @@ class JointVotes:
     transform : (4, 4) float64, from the mesh's space to the normalised frame
     symmetric : bool, whether the shape is left-right symmetric
     notes : tuple of str, what was detected or decided
+    landmarks : Landmarks of the standard skeleton (:mod:`.standard_skeleton`),
+        with the kind of body; None when only the free-form skeleton was asked for
+    proxy_vertices : (n, 3) float64, the normalised proxy's vertices (None with ``landmarks``)
     """
 
     points: np.ndarray
@@ -101,6 +119,8 @@ class JointVotes:
     transform: np.ndarray
     symmetric: bool
     notes: tuple = ()
+    landmarks: Landmarks | None = None
+    proxy_vertices: np.ndarray | None = None
 
 
 def facing_turns(vertices: np.ndarray) -> int:
@@ -185,8 +205,33 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
+    report(progress, 0.8, "Running the landmark network")
+    landmarks = predict_landmarks(graph)
     report(progress, 1.0, "Joint votes done")
-    return replace(votes, notes=tuple(notes))
+    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices)
+
+
+def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple[str, str]:
+    """The skeleton ``template`` gives on these votes, and a note saying why.
+
+    Returns
+    -------
+    (kind, note): ``kind`` is ``"biped"``, ``"quadruped"`` or ``"free-form"``.
+    ``auto`` takes the landmark network's kind when it is a biped or a
+    quadruped with probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`.
+    """
+    if template not in TEMPLATES:
+        raise InputError(f"Unknown template '{template}': use one of {', '.join(TEMPLATES)}.")
+    if template == FREE_FORM or votes.landmarks is None:
+        return FREE_FORM, "Template: free-form skeleton, as asked."
+    guess, confidence = votes.landmarks.kind, votes.landmarks.confidence
+    seen = f"the landmark network reads the body as {guess} ({confidence:.0%} sure)"
+    if template != AUTO:
+        return template, f"Template: standard {template} skeleton, as asked; {seen}."
+    if guess in STANDARD_KINDS and confidence >= KIND_CONFIDENCE:
+        return guess, f"Template: standard {guess} skeleton; {seen}."
+    return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
+                       "force one.")
 
 
 def graph_votes(weights: dict, graph: JointGraph, solid: SolidDepth | None = None,
@@ -242,7 +287,8 @@ def connect_joints(joints: np.ndarray, mirror: np.ndarray, solid: SolidDepth) ->
 
 def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWIDTH,
                         density_threshold: float = DEFAULT_DENSITY_THRESHOLD,
-                        symmetry: bool = DEFAULT_SYMMETRY) -> Skeleton:
+                        symmetry: bool = DEFAULT_SYMMETRY, template: str = DEFAULT_TEMPLATE,
+                        names: str = DEFAULT_PRESET) -> Skeleton:
     """The skeleton of the votes at a level of detail, in the mesh's space.
 
     Parameters
@@ -251,11 +297,21 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     bandwidth : float in [MIN_BANDWIDTH, MAX_BANDWIDTH], share of the largest side
     density_threshold : float in [0, 1]
     symmetry : bool, mirror and pair when the shape is symmetric
+    template : one of :data:`.standard_skeleton.TEMPLATES` (:func:`chosen_template`);
+        a standard skeleton does not depend on the bandwidth and the density threshold
+    names : a preset of :data:`...skeleton.name_presets.PRESETS`; a skeleton
+        that is not a standard biped keeps Rigify's names (:func:`naming_note` says so)
 
     Returns
     -------
     Skeleton, every bone deforming, parents first, names unique.
     """
+    kind, _ = chosen_template(votes, template)
+    if kind != FREE_FORM:
+        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, votes.symmetric and symmetry)
+        to_mesh = np.linalg.inv(votes.transform)
+        return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
+                        preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))
     if not MIN_BANDWIDTH <= bandwidth <= MAX_BANDWIDTH:
         raise InputError(f"The bandwidth must be between {MIN_BANDWIDTH} and {MAX_BANDWIDTH}, got {bandwidth}.")
     if not MIN_DENSITY_THRESHOLD <= density_threshold <= MAX_DENSITY_THRESHOLD:
@@ -270,10 +326,17 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     position = np.empty_like(order)
     position[order] = np.arange(len(order))
     mirror = np.where(mirror[order] >= 0, position[np.maximum(mirror[order], 0)], -1)
-    names = role_names(joints, parents, mirror)
+    bone_names = preset_names(role_names(joints, parents, mirror), names)[0]
     tails = leaf_tails_inside(joints, parents, derived_tails(joints, parents), votes.solid)
     to_mesh = np.linalg.inv(votes.transform)
-    return Skeleton(apply_transform(joints, to_mesh), parents, names, apply_transform(tails, to_mesh))
+    return Skeleton(apply_transform(joints, to_mesh), parents, bone_names, apply_transform(tails, to_mesh))
+
+
+def naming_note(skeleton: Skeleton, names: str = DEFAULT_PRESET) -> str:
+    """Why a skeleton kept Rigify's names instead of ``names`` ("" when it did not)."""
+    if names == DEFAULT_PRESET or preset_of(skeleton.names) == names:
+        return ""
+    return f"the bones keep Rigify's names: {names} names exist for a standard biped skeleton only"
 
 
 def leaf_tails_inside(joints: np.ndarray, parents: np.ndarray, tails: np.ndarray, solid: SolidDepth) -> np.ndarray:
@@ -305,7 +368,9 @@ def leaf_tails_inside(joints: np.ndarray, parents: np.ndarray, tails: np.ndarray
 
 def predict_skeleton(mesh: Mesh, *, bandwidth: float = DEFAULT_BANDWIDTH,
                      density_threshold: float = DEFAULT_DENSITY_THRESHOLD, symmetry: bool = DEFAULT_SYMMETRY,
+                     template: str = DEFAULT_TEMPLATE, names: str = DEFAULT_PRESET,
                      progress: ProgressCallback | None = None) -> Skeleton:
     """:func:`predict_votes` then :func:`skeleton_from_votes`."""
     votes = predict_votes(mesh, progress)
-    return skeleton_from_votes(votes, bandwidth=bandwidth, density_threshold=density_threshold, symmetry=symmetry)
+    return skeleton_from_votes(votes, bandwidth=bandwidth, density_threshold=density_threshold, symmetry=symmetry,
+                               template=template, names=names)

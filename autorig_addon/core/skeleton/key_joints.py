@@ -226,6 +226,11 @@ CONVENTIONS = (
         "stk_bone", hips=("Bone.Hips", "Bone.Spine"), neck=("Bone.Neck",), head=("Bone.Head",),
         shoulder=("Bone.Arm_Upper{s}",), elbow=("Bone.Arm_Lower{s}",), wrist=("Bone.Hand{s}",),
         hip=("Bone.Leg_Upper{s}",), knee=("Bone.Leg_Lower{s}",), ankle=("Bone.Foot{s}",)),
+    # MakeHuman's default skeleton (the bundled CC0 body).
+    _convention(
+        "makehuman", hips=("root",), neck=("neck01",), head=("head",), shoulder=("upperarm01{s}",),
+        elbow=("lowerarm01{s}",), wrist=("wrist{s}",), hip=("upperleg01{s}",), knee=("lowerleg01{s}",),
+        ankle=("foot{s}",), requires=("upperleg01{s}",)),
     # Kenney's mini characters: one bone per arm and leg.
     _convention(
         "kenney", hips=("torso",), head=("head",), shoulder=("arm{s}",), hip=("leg{s}",),
@@ -259,13 +264,18 @@ class KeyJoints:
     positions: dict
 
 
-def key_joints(names, joints, left_direction=None) -> KeyJoints:
+def key_joints(names, joints, left_direction=None, parents=None) -> KeyJoints:
     """The key joints of a skeleton, read from its bone names.
 
     Parameters
     ----------
     names : sequence of str, bone names
     joints : (j, 3) array, bone heads
+    parents : optional (j,) int array. When given and the rig's hips bone
+        is not one the legs hang from, the hips are the joint they do hang
+        from (:func:`leg_root`) if it lies nearer the hip joints: Quaternius'
+        monsters put ``Hips`` below the hip joints beside the legs, which hang
+        from ``Body`` at their height.
     left_direction : optional (3,) array, the character's left in the
         joints' space. When given, a pair of side roles whose ``.L`` joint
         lies further right than its ``.R`` twin is swapped: some artists
@@ -289,5 +299,50 @@ def key_joints(names, joints, left_direction=None) -> KeyJoints:
             left, right = best.get(role + LEFT), best.get(role + RIGHT)
             if left is not None and right is not None and (joints[left] - joints[right]) @ left_direction < 0:
                 best[role + LEFT], best[role + RIGHT] = right, left
+    if parents is not None and "hip" + LEFT in best and "hip" + RIGHT in best:
+        best = _hips_the_legs_hang_from(best, joints, np.asarray(parents, dtype=np.int64).reshape(-1))
     ordered = {role: best[role] for role in KEY_JOINTS if role in best}
     return KeyJoints(best_name, ordered, {role: joints[index].copy() for role, index in ordered.items()})
+
+
+#: A joint is on the midline between the thighs when it lies within this
+#: share of half their spacing from the plane halfway between them.
+MIDLINE_SHARE = 0.25
+
+
+def _ancestors(parents: np.ndarray, joint: int) -> list:
+    found = []
+    while parents[joint] >= 0:
+        joint = int(parents[joint])
+        found.append(joint)
+    return found
+
+
+def _hips_the_legs_hang_from(found: dict, joints: np.ndarray, parents: np.ndarray) -> dict:
+    left, right = found["hip" + LEFT], found["hip" + RIGHT]
+    hips = found.get("hips")
+    if hips is not None and hips in _ancestors(parents, left):
+        return found
+    root = leg_root(joints, parents, left, right)
+    if root is None:
+        return found
+    middle = (joints[left] + joints[right]) / 2.0
+    if hips is None or np.linalg.norm(joints[root] - middle) < np.linalg.norm(joints[hips] - middle):
+        found = {**found, "hips": root}
+    return found
+
+
+def leg_root(joints: np.ndarray, parents: np.ndarray, left_thigh: int, right_thigh: int):
+    """The first ancestor of the left thigh on the midline between the thighs, or None."""
+    across = joints[left_thigh] - joints[right_thigh]
+    half = float(np.linalg.norm(across)) / 2.0
+    if half <= 0.0:
+        return None
+    across /= 2.0 * half
+    middle = (joints[left_thigh] + joints[right_thigh]) / 2.0
+    joint = int(parents[left_thigh])
+    while joint >= 0:
+        if abs(float((joints[joint] - middle) @ across)) <= MIDLINE_SHARE * half:
+            return joint
+        joint = int(parents[joint])
+    return None

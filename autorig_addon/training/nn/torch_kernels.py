@@ -100,6 +100,11 @@ def masked_row_softmax(logits: torch.Tensor, valid: torch.Tensor) -> torch.Tenso
     return torch.softmax(logits.masked_fill(~valid, float("-inf")), dim=1)
 
 
+def column_softmax(logits: torch.Tensor) -> torch.Tensor:
+    """Softmax of each column over its rows."""
+    return torch.softmax(logits, dim=0)
+
+
 #: Activations by name, as in the numpy twin.
 ACTIVATIONS = {"relu": F.relu, "leaky_relu": leaky_relu, "none": identity}
 
@@ -108,7 +113,7 @@ TORCH = Operations(
     name="torch", concat=concat, column_max=column_max, repeat_rows=repeat_rows, gather=gather,
     segment_sum=segment_sum, segment_mean=segment_mean, segment_max=segment_max, segment_min=segment_min,
     linear=linear, activations=ACTIVATIONS, log=torch.log, sqrt=torch.sqrt, clamp_min=clamp_min, where=where,
-    nonzero=nonzero, scatter=scatter, masked_row_softmax=masked_row_softmax,
+    nonzero=nonzero, scatter=scatter, masked_row_softmax=masked_row_softmax, column_softmax=column_softmax,
 )
 
 

@@ -63,6 +63,7 @@ from ..runs import (
     start_run,
     write_weights,
 )
+from .landmarks import train_landmark_network
 from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
 
 #: Weight of the attention loss beside the offset loss.
@@ -82,6 +83,11 @@ JITTER_COPIES = 4
 #: humans on one skeleton) would take most of each epoch's time and weigh
 #: one family most.
 SCORED_PER_FAMILY = 2
+#: The held-out score each network's epoch is chosen by (lower is better).
+SCORE_NAMES = {"joints": "cd_j2j", "landmarks": "landmark_error", "bones": "cross_entropy",
+               "root": "cross_entropy"}
+#: Networks trained full batch on a fixed family sample of characters.
+FULL_BATCH_NETWORKS = ("bones", "root")
 #: Epochs between progress lines (and history entries) of the full-batch networks.
 FULL_BATCH_LOG_EVERY = 100
 
@@ -240,25 +246,30 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     """
     spec = rig_network(network)
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
-                       score_name="cd_j2j" if network == "joints" else "cross_entropy")
+                       score_name=SCORE_NAMES.get(network, "cross_entropy"))
     folder = Path(examples_dir or default_examples_dir(seed))
-    examples = build_examples(training_samples(Path(sample_dir), purpose=PURPOSE_SKELETON), folder, seed)
+    samples = training_samples(Path(sample_dir), purpose=PURPOSE_SKELETON)
+    examples = build_examples(samples, folder, seed)
     names = sorted(examples)
     held_out = held_out_names(names)
     families = character_families(names)
     # Scored: at most SCORED_PER_FAMILY held-out characters of a family, as they are (not stretched).
     held_names = set(family_sample(sorted(held_out), families, SCORED_PER_FAMILY))
     trained = [name for name in names if name not in held_out]
-    if network != "joints":
+    if network in FULL_BATCH_NETWORKS:
         # Full batch, so no epoch redraws the families: a fixed sample of each family's characters.
         trained = family_sample(trained, families, CHARACTERS_PER_FAMILY)
-    made = build_examples(procedural_samples(procedural), folder, seed)
+    procedural_made = procedural_samples(procedural)
+    made = build_examples(procedural_made, folder, seed)
     train = [example for name in trained for example in examples[name]]
     train += [example for name in sorted(made) for example in made[name]]
     holdout = [examples[name][0] for name in names if name in held_names]
     record.details.update(train_examples=len(train), holdout=sorted(held_names), procedural=procedural)
     if network == "joints":
         weights = train_joint_network(train, holdout, record)
+    elif network == "landmarks":
+        by_name = {sample.name: sample for sample in list(samples) + list(procedural_made)}
+        weights = train_landmark_network(by_name, train, holdout, record)
     else:
         weights = train_connectivity_network(spec, train, holdout, record)
     write_weights(spec, weights, record, output)

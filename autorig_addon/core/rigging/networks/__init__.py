@@ -5,10 +5,12 @@ from __future__ import annotations
 
 from ...errors import InputError
 from ...nn.spec import NetworkSpec
-from . import bones, joints, root
+from . import bones, joints, landmarks, root
 
-#: Every skeleton network by name, in the order a skeleton is predicted.
-RIG_NETWORKS: dict[str, NetworkSpec] = {spec.name: spec for spec in (joints.SPEC, bones.SPEC, root.SPEC)}
+#: Every skeleton network by name: the free-form skeleton's in the order
+#: they run, then the standard skeleton's.
+RIG_NETWORKS: dict[str, NetworkSpec] = {
+    spec.name: spec for spec in (joints.SPEC, bones.SPEC, root.SPEC, landmarks.SPEC)}
 #: Names ``train rig --model`` accepts.
 NETWORK_NAMES = tuple(RIG_NETWORKS)
 

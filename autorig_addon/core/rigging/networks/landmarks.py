@@ -1,0 +1,66 @@
+"""The landmark network: where each key joint of a standard skeleton lies, and what kind of body it is.
+
+Make-It-Animatable (Guo et al., CVPR 2025) places a fixed template's joints
+by letting every vertex vote for every template joint; we do the same on
+RigNet's trunk (:mod:`.joints`, whose trained trunk it starts from). Per
+vertex and per landmark of :data:`...skeleton.key_joints.KEY_JOINTS` (hips,
+neck, head, and per side shoulder, elbow, wrist, hip, knee, ankle), an
+*offset* from the vertex to the landmark and a *weight* logit; a landmark is
+the weighted mean of its votes, the weights a softmax over the vertices. A
+third head reads the shape code and says the kind of body: biped,
+quadruped or other (:data:`BODY_KINDS`).
+"""
+
+from __future__ import annotations
+
+from ...nn.convolution import gmedge_trunk
+from ...nn.layers import mlp
+from ...nn.operations import Array, Operations
+from ...nn.spec import Dense, NetworkSpec, TrainingSettings
+from ...skeleton.key_joints import KEY_JOINTS
+from ..joint_features import JointGraph
+from .joints import TRUNK, WIDTH
+from .trained import TRAINED_FOLDER
+
+#: The landmarks, in output order.
+LANDMARKS = KEY_JOINTS
+#: Kinds of body the network tells apart, in output order.
+BODY_KINDS = ("biped", "quadruped", "other")
+
+
+def landmark_network(ops: Operations, params: dict, graph: JointGraph) -> tuple[Array, Array]:
+    """Landmark positions and body-kind logits.
+
+    Returns
+    -------
+    landmarks : (k, 3) float array, normalised units, in :data:`LANDMARKS` order
+    kind_logits : (1, 3) float array, in :data:`BODY_KINDS` order
+    """
+    joined = gmedge_trunk(ops, params, graph.vertex_features, graph.mesh_edges, graph.ball_edges, TRUNK.blocks,
+                          activation=SPEC.activation)
+    count = len(LANDMARKS)
+    offsets = mlp(ops, params, joined, "offset.", activation=SPEC.activation, activate_last=False)
+    weights = ops.column_softmax(mlp(ops, params, joined, "weight.", activation=SPEC.activation,
+                                     activate_last=False))
+    vertices = graph.vertex_features[:, :3]  # the position columns: float32, turned with the features in training
+    votes = vertices[:, None, :] + offsets.reshape(offsets.shape[0], count, 3)
+    landmarks = (weights[:, :, None] * votes).sum(0)
+    kind_logits = mlp(ops, params, joined[:1, -TRUNK.shape_width:], "kind.", activation=SPEC.activation,
+                      activate_last=False)
+    return landmarks, kind_logits
+
+
+SPEC = NetworkSpec(
+    name="landmarks",
+    label="Landmarks",
+    description="Places the key joints of a standard biped or quadruped skeleton and tells the kind of body",
+    inputs="JointGraph",
+    layers=(TRUNK, Dense("offset", (TRUNK.out_width, 2 * WIDTH, WIDTH, 3 * len(LANDMARKS))),
+            Dense("weight", (TRUNK.out_width, WIDTH, len(LANDMARKS))),
+            Dense("kind", (TRUNK.shape_width, WIDTH, len(BODY_KINDS)))),
+    forward=landmark_network,
+    # About 40 s an epoch of 138 family-sampled steps on one CPU thread; the held-out error still fell
+    # from epoch 50 to 60 of a 60-epoch run (docs/models.md).
+    training=TrainingSettings(epochs=70, learning_rate=2e-3),
+    weights_file=TRAINED_FOLDER / "landmarks.npz",
+)

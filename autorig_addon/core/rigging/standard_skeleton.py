@@ -1,0 +1,247 @@
+"""A standard biped or quadruped skeleton from the landmark network.
+
+The landmark network (:mod:`.networks.landmarks`) places the key joints
+(hips, neck, head, and per side shoulder, elbow, wrist, hip, knee, ankle)
+and says the kind of body. Around them this module lays out the bones of
+Rigify's metarigs, named as :mod:`.role_names` names a recognised body:
+
+* **biped** (``basic_human``): ``spine`` to ``spine.003`` from the hips to
+  the neck, ``neck``, ``head`` up to the top of the head; per side
+  ``shoulder`` (the clavicle, from near the midline), ``upper_arm``,
+  ``forearm``, ``hand``; ``thigh``, ``shin``, ``foot`` (ankle to the ball of
+  the foot), ``toe``.
+* **quadruped** (``basic_quadruped``): ``spine`` to ``spine.003`` from the
+  hips to the neck, ``neck``, ``head`` to the snout; ``tail``,
+  ``tail.001``, ``tail.002`` when the body runs on behind the hips; per side
+  ``shoulder`` (the scapula), ``front_thigh``, ``front_shin``,
+  ``front_foot``, ``front_toe``; ``thigh``, ``shin``, ``foot``, ``toe``.
+
+Ends the landmarks do not give (top of the head, snout, feet and toes on
+the ground, hand, tail) are read from the mesh. Left and right landmarks are
+made mirror images of each other (averaged across x = 0) when they nearly
+are, so a character a little off symmetric (a held prop, one arm raised a
+few degrees) still gets a symmetric skeleton; midline landmarks are put on
+x = 0 when the shape is symmetric.
+
+Everything here is in the normalised frame (feet at z = 0, largest side 1,
+facing -y, left at +x).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..nn.numpy_kernels import NUMPY
+from ..nn.spec import shipped_weights
+from ..skeleton.key_joints import LEFT, RIGHT
+from ..skeleton.naming import chain_names
+from ..types import Skeleton
+from .joint_features import JointGraph
+from .networks import landmarks as landmark_network
+from .networks.landmarks import BODY_KINDS, LANDMARKS
+
+BIPED, QUADRUPED, OTHER = BODY_KINDS
+#: Template choices: the network's guess, one kind forced, or the free-form skeleton.
+AUTO, FREE_FORM = "auto", "free-form"
+TEMPLATES = (AUTO, BIPED, QUADRUPED, FREE_FORM)
+#: With ``auto``, a standard skeleton is built when the network gives its
+#: kind at least this probability; below it the free-form skeleton is kept.
+KIND_CONFIDENCE = 0.6
+#: Twin landmarks closer than this to each other's mirror image (share of
+#: the largest side) are made exactly symmetric.
+SYMMETRIC_PAIR_DISTANCE = 0.08
+#: Bones of the spine from the hips to the neck.
+SPINE_BONES = 4
+#: Bones of a tail.
+TAIL_BONES = 3
+#: The body runs on behind the hips by at least this much (share of the
+#: largest side) for a quadruped to get a tail.
+MIN_TAIL_LENGTH = 0.08
+#: A hand is this share of its forearm's length when the mesh does not say.
+HAND_SHARE = 0.4
+
+
+@dataclass(frozen=True)
+class Landmarks:
+    """The landmark network's answer for one character (normalised frame).
+
+    Attributes
+    ----------
+    points : dict mapping each name of :data:`LANDMARKS` to its (3,) position
+    kind_probabilities : dict mapping each kind of :data:`BODY_KINDS` to its probability
+    """
+
+    points: dict
+    kind_probabilities: dict
+
+    @property
+    def kind(self) -> str:
+        return max(self.kind_probabilities, key=self.kind_probabilities.get)
+
+    @property
+    def confidence(self) -> float:
+        return float(self.kind_probabilities[self.kind])
+
+
+def predict_landmarks(graph: JointGraph, weights: dict | None = None) -> Landmarks:
+    """Run the landmark network on a normalised proxy's graph."""
+    weights = shipped_weights(landmark_network.SPEC).weights if weights is None else weights
+    points, logits = landmark_network.SPEC.forward(NUMPY, weights, graph)
+    logits = np.asarray(logits, dtype=np.float64).reshape(-1)
+    probabilities = np.exp(logits - logits.max())
+    probabilities /= probabilities.sum()
+    return Landmarks({name: np.asarray(points[index], dtype=np.float64) for index, name in enumerate(LANDMARKS)},
+                     {kind: float(probabilities[index]) for index, kind in enumerate(BODY_KINDS)})
+
+
+def symmetrised(points: dict, symmetric_shape: bool) -> dict:
+    """Landmarks with near-twin pairs made mirror images and, on a symmetric
+    shape, the midline ones on x = 0."""
+    points = {name: np.array(point, dtype=np.float64) for name, point in points.items()}
+    flip = np.array([-1.0, 1.0, 1.0])
+    for name in points:
+        if not name.endswith(LEFT):
+            if symmetric_shape and not name.endswith(RIGHT):
+                points[name][0] = 0.0
+            continue
+        twin = name[: -len(LEFT)] + RIGHT
+        left, right = points[name], points[twin]
+        if np.linalg.norm(left - right * flip) <= SYMMETRIC_PAIR_DISTANCE:
+            mean = (left + right * flip) / 2.0
+            mean[0] = abs(mean[0])
+            points[name], points[twin] = mean, mean * flip
+    return points
+
+
+class _Builder:
+    """Bones added one at a time: head, tail, parent name."""
+
+    def __init__(self):
+        self.names, self.heads, self.tails, self.parents = [], [], [], []
+
+    def add(self, name: str, head, tail, parent: str | None) -> None:
+        self.names.append(name)
+        self.heads.append(np.asarray(head, dtype=np.float64))
+        self.tails.append(np.asarray(tail, dtype=np.float64))
+        self.parents.append(-1 if parent is None else self.names.index(parent))
+
+    def chain(self, names: list, points: list, parent: str | None) -> None:
+        for name, head, tail in zip(names, points[:-1], points[1:]):
+            self.add(name, head, tail, parent)
+            parent = name
+
+    def skeleton(self) -> Skeleton:
+        return Skeleton(np.array(self.heads), np.array(self.parents, dtype=np.int64), tuple(self.names),
+                        np.array(self.tails))
+
+
+def _spine_points(hips: np.ndarray, neck: np.ndarray, count: int) -> list:
+    return [hips + (neck - hips) * step / count for step in range(count + 1)]
+
+
+def _near(vertices: np.ndarray, point: np.ndarray, radius: float) -> np.ndarray:
+    return vertices[np.linalg.norm(vertices[:, :2] - point[:2], axis=1) <= radius]
+
+
+def _top_above(vertices: np.ndarray, point: np.ndarray, radius: float, fallback: np.ndarray) -> np.ndarray:
+    """The top of the mesh straight above ``point`` (the crown of a head)."""
+    column = _near(vertices, point, radius)
+    column = column[column[:, 2] > point[2]]
+    if not len(column):
+        return fallback
+    return np.array([point[0], point[1], column[:, 2].max()])
+
+
+def _foot_points(vertices: np.ndarray, ankle: np.ndarray, radius: float) -> tuple:
+    """Ball and tip of the foot below ``ankle``: the most forward (-y) part
+    of the mesh under the ankle within ``radius``, near the ground."""
+    around = vertices[(np.abs(vertices[:, 0] - ankle[0]) <= radius) & (vertices[:, 2] <= ankle[2])
+                      & (np.abs(vertices[:, 1] - ankle[1]) <= 3.0 * radius)]
+    ground = float(around[:, 2].min()) if len(around) else 0.0
+    front = float(around[:, 1].min()) if len(around) else ankle[1] - radius
+    front = min(front, ankle[1] - 0.25 * radius)
+    height = ground + 0.25 * max(ankle[2] - ground, 0.0)
+    tip = np.array([ankle[0], front, height])
+    ball = np.array([ankle[0], ankle[1] + 0.7 * (front - ankle[1]), height])
+    return ball, tip
+
+
+def _hand_tail(vertices: np.ndarray, elbow: np.ndarray, wrist: np.ndarray) -> np.ndarray:
+    """Where the hand ends: the farthest mesh point past the wrist along the
+    forearm, within a forearm's width of its line, capped at the forearm's length."""
+    direction = wrist - elbow
+    length = float(np.linalg.norm(direction))
+    if length <= 1e-9:
+        return wrist + np.array([0.0, 0.0, 0.02])
+    direction /= length
+    offsets = vertices - wrist
+    along = offsets @ direction
+    across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
+    reach = along[(along > 0) & (across <= 0.35 * length)]
+    extent = min(float(reach.max()), length) if len(reach) else HAND_SHARE * length
+    return wrist + direction * max(0.85 * extent, 0.2 * length)
+
+
+def biped_skeleton(points: dict, vertices: np.ndarray) -> Skeleton:
+    """Rigify's human layout around the landmarks (see the module docstring)."""
+    build = _Builder()
+    hips, neck, head = points["hips"], points["neck"], points["head"]
+    spine = _spine_points(hips, neck, SPINE_BONES)
+    build.chain(chain_names("spine", SPINE_BONES), spine, None)
+    neck_length = float(np.linalg.norm(head - neck))
+    crown = _top_above(vertices, head, max(neck_length, 0.03), head + (head - neck) * 2.0)
+    build.chain(["neck", "head"], [neck, head, crown], "spine.003")
+    for side in (LEFT, RIGHT):
+        shoulder, elbow, wrist = points["shoulder" + side], points["elbow" + side], points["wrist" + side]
+        clavicle = np.array([0.25 * shoulder[0], shoulder[1], 0.5 * (shoulder[2] + neck[2])])
+        build.add("shoulder" + side, clavicle, shoulder, "spine.003")
+        hand_end = _hand_tail(vertices, elbow, wrist)
+        build.chain(["upper_arm" + side, "forearm" + side, "hand" + side], [shoulder, elbow, wrist, hand_end],
+                    "shoulder" + side)
+        hip, knee, ankle = points["hip" + side], points["knee" + side], points["ankle" + side]
+        ball, tip = _foot_points(vertices, ankle, max(0.5 * abs(hip[0]), 0.03))
+        build.chain(["thigh" + side, "shin" + side, "foot" + side, "toe" + side], [hip, knee, ankle, ball, tip],
+                    "spine")
+    return build.skeleton()
+
+
+def quadruped_skeleton(points: dict, vertices: np.ndarray) -> Skeleton:
+    """Rigify's quadruped layout around the landmarks (see the module docstring)."""
+    build = _Builder()
+    hips, neck, head = points["hips"], points["neck"], points["head"]
+    spine = _spine_points(hips, neck, SPINE_BONES)
+    build.chain(chain_names("spine", SPINE_BONES), spine, None)
+    midline = vertices[np.abs(vertices[:, 0]) <= 0.05]
+    ahead = midline[(midline[:, 1] < head[1]) & (np.abs(midline[:, 2] - head[2]) <= 0.15)]
+    snout = np.array([0.0, float(ahead[:, 1].min()), head[2]]) if len(ahead) else head + (head - neck)
+    build.chain(["neck", "head"], [neck, head, snout], "spine.003")
+    behind = midline[(midline[:, 1] > hips[1]) & (midline[:, 2] >= 0.5 * hips[2])]
+    if len(behind) and float(behind[:, 1].max()) - hips[1] >= MIN_TAIL_LENGTH:
+        end = behind[np.argmax(behind[:, 1])]
+        tail = [hips + (end - hips) * step / TAIL_BONES for step in range(TAIL_BONES + 1)]
+        build.chain(chain_names("tail", TAIL_BONES), tail, "spine")
+    for side in (LEFT, RIGHT):
+        shoulder, elbow, wrist = points["shoulder" + side], points["elbow" + side], points["wrist" + side]
+        withers = np.array([0.5 * shoulder[0], shoulder[1], shoulder[2] + 0.5 * max(neck[2] - shoulder[2], 0.02)])
+        build.add("shoulder" + side, withers, shoulder, "spine.003")
+        front_ball, front_tip = _foot_points(vertices, wrist, max(0.5 * abs(shoulder[0]), 0.02))
+        build.chain(["front_thigh" + side, "front_shin" + side, "front_foot" + side, "front_toe" + side],
+                    [shoulder, elbow, wrist, front_ball, front_tip], "shoulder" + side)
+        hip, knee, ankle = points["hip" + side], points["knee" + side], points["ankle" + side]
+        ball, tip = _foot_points(vertices, ankle, max(0.5 * abs(hip[0]), 0.02))
+        build.chain(["thigh" + side, "shin" + side, "foot" + side, "toe" + side], [hip, knee, ankle, ball, tip],
+                    "spine")
+    return build.skeleton()
+
+
+def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool) -> Skeleton:
+    """The standard skeleton of ``kind`` (biped or quadruped) around the
+    landmarks, in the normalised frame."""
+    points = symmetrised(landmarks.points, symmetric_shape)
+    if kind == BIPED:
+        return biped_skeleton(points, vertices)
+    if kind == QUADRUPED:
+        return quadruped_skeleton(points, vertices)
+    raise ValueError(f"No standard skeleton for '{kind}'.")

@@ -1,0 +1,169 @@
+"""The standard biped and quadruped skeletons laid out around landmarks, and the template choice."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.dataset.normalise import normalise
+from autorig_addon.core.errors import InputError
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict
+from autorig_addon.core.rigging.metarig import metarig_placement
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.core.rigging.standard_skeleton import (
+    BIPED,
+    FREE_FORM,
+    QUADRUPED,
+    SYMMETRIC_PAIR_DISTANCE,
+    Landmarks,
+    biped_skeleton,
+    quadruped_skeleton,
+    symmetrised,
+)
+from autorig_addon.core.skeleton.key_joints import key_joints
+from autorig_addon.core.skeleton.naming import mirror_name
+from autorig_addon.core.types import Skeleton
+
+BIPED_BONES = {
+    "spine", "spine.001", "spine.002", "spine.003", "neck", "head",
+    *(name + side for side in (".L", ".R") for name in (
+        "shoulder", "upper_arm", "forearm", "hand", "thigh", "shin", "foot", "toe")),
+}
+
+
+def generated_landmarks(kind: str, seed: int = 0):
+    """A procedural character in the normalised frame and its generator's key joints as landmarks."""
+    character = generate_character(seed, kind)
+    normalised = normalise(character.mesh, character.skeleton)
+    skeleton = normalised.skeleton
+    points = dict(key_joints(skeleton.names, skeleton.joints, left_direction=[1, 0, 0]).positions)
+    if kind == QUADRUPED:
+        # Rigify's quadruped numbers the neck and head on along the spine: the two front-most midline joints.
+        midline = [index for index, name in enumerate(skeleton.names) if name.startswith("spine")]
+        front = sorted(midline, key=lambda index: skeleton.joints[index, 1])
+        points["head"], points["neck"] = skeleton.joints[front[0]], skeleton.joints[front[1]]
+    assert set(points) == set(LANDMARKS)
+    return normalised.mesh.vertices, points
+
+
+def assert_tree(skeleton):
+    assert len(set(skeleton.names)) == skeleton.bone_count
+    assert skeleton.parents[0] == -1 and (skeleton.parents < 0).sum() == 1
+    assert np.all(skeleton.parents[1:] < np.arange(1, skeleton.bone_count))
+    assert np.all(skeleton.bone_lengths > 0)
+
+
+def assert_mirrored(skeleton, atol=1e-12):
+    index = {name: k for k, name in enumerate(skeleton.names)}
+    for name, k in index.items():
+        twin = index[mirror_name(name)]
+        np.testing.assert_allclose(skeleton.joints[k] * [-1, 1, 1], skeleton.joints[twin], atol=atol)
+        np.testing.assert_allclose(skeleton.tails[k] * [-1, 1, 1], skeleton.tails[twin], atol=atol)
+
+
+def test_the_biped_skeleton_is_rigifys_human_layout_through_the_landmarks():
+    vertices, points = generated_landmarks(BIPED)
+    skeleton = biped_skeleton(symmetrised(points, True), vertices)
+    assert_tree(skeleton)
+    assert set(skeleton.names) == BIPED_BONES
+    found = key_joints(skeleton.names, skeleton.joints)
+    assert tuple(found.positions) == LANDMARKS
+    symmetric = symmetrised(points, True)
+    for role, position in found.positions.items():
+        np.testing.assert_allclose(position, symmetric[role], atol=1e-12, err_msg=role)
+    assert_mirrored(skeleton)
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    parent = {name: skeleton.names[p] if p >= 0 else None for name, p in zip(skeleton.names, skeleton.parents)}
+    assert parent["thigh.L"] == "spine" and parent["upper_arm.L"] == "shoulder.L" and parent["neck"] == "spine.003"
+    # The head bone reaches the top of the mesh; the toes lie ahead of the ankle, low on the foot.
+    assert skeleton.tails[names["head"], 2] == pytest.approx(vertices[:, 2].max(), abs=0.02)
+    toe_tip, ankle = skeleton.tails[names["toe.L"]], points["ankle.L"]
+    assert toe_tip[1] < ankle[1] and toe_tip[2] < ankle[2] / 2
+    low, high = vertices.min(0) - 0.02, vertices.max(0) + 0.02
+    assert np.all(skeleton.joints >= low) and np.all(skeleton.tails <= high)
+
+
+def test_the_quadruped_skeleton_has_front_and_hind_legs_and_a_tail():
+    vertices, points = generated_landmarks(QUADRUPED)
+    skeleton = quadruped_skeleton(symmetrised(points, True), vertices)
+    assert_tree(skeleton)
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    for chain in ("shoulder", "front_thigh", "front_shin", "front_foot", "front_toe", "thigh", "shin", "foot", "toe"):
+        assert chain + ".L" in names and chain + ".R" in names
+    # The generator's wolf has a long tail behind the hips.
+    assert {"tail", "tail.001", "tail.002"} <= set(names)
+    assert skeleton.tails[names["tail.002"], 1] > points["hips"][1] + 0.1
+    # The head points forward (-y) to the snout.
+    assert skeleton.tails[names["head"], 1] < points["head"][1]
+    found = key_joints(skeleton.names, skeleton.joints)
+    np.testing.assert_allclose(found.positions["shoulder.L"], symmetrised(points, True)["shoulder.L"], atol=1e-12)
+    assert_mirrored(skeleton)
+
+
+def test_near_twin_landmarks_are_made_mirror_images_and_far_ones_are_kept():
+    points = {"hips": np.array([0.01, 0.0, 0.5]), "shoulder.L": np.array([0.2, 0.0, 0.8]),
+              "shoulder.R": np.array([-0.22, 0.02, 0.8]), "wrist.L": np.array([0.4, 0.0, 0.8]),
+              "wrist.R": np.array([-0.2, 0.0, 0.4])}
+    result = symmetrised(points, symmetric_shape=True)
+    np.testing.assert_allclose(result["shoulder.L"], [0.21, 0.01, 0.8])
+    np.testing.assert_allclose(result["shoulder.R"], [-0.21, 0.01, 0.8])
+    # One arm raised far from its twin's mirror image stays as predicted.
+    assert np.linalg.norm(points["wrist.L"] - points["wrist.R"] * [-1, 1, 1]) > SYMMETRIC_PAIR_DISTANCE
+    np.testing.assert_array_equal(result["wrist.L"], points["wrist.L"])
+    assert result["hips"][0] == 0.0
+    assert symmetrised(points, symmetric_shape=False)["hips"][0] == 0.01
+
+
+def votes_with(kind_probabilities):
+    landmarks = Landmarks({name: np.zeros(3) for name in LANDMARKS}, kind_probabilities)
+    return predict.JointVotes(np.zeros((1, 3)), np.ones(1), None, np.eye(4), True, (), landmarks, np.zeros((1, 3)))
+
+
+@pytest.mark.parametrize("probabilities, template, kind", [
+    ({"biped": 0.9, "quadruped": 0.05, "other": 0.05}, "auto", BIPED),
+    ({"biped": 0.1, "quadruped": 0.8, "other": 0.1}, "auto", QUADRUPED),
+    ({"biped": 0.5, "quadruped": 0.1, "other": 0.4}, "auto", FREE_FORM),
+    ({"biped": 0.05, "quadruped": 0.05, "other": 0.9}, "auto", FREE_FORM),
+    ({"biped": 0.05, "quadruped": 0.05, "other": 0.9}, "quadruped", QUADRUPED),
+    ({"biped": 0.9, "quadruped": 0.05, "other": 0.05}, "free-form", FREE_FORM),
+])
+def test_the_template_is_the_networks_kind_when_it_is_sure_or_the_users_choice(probabilities, template, kind):
+    chosen, note = predict.chosen_template(votes_with(probabilities), template)
+    assert chosen == kind
+    assert note.startswith("Template: ") and (template == "free-form" or "% sure" in note)
+
+
+def test_an_unknown_template_is_refused():
+    with pytest.raises(InputError, match="Unknown template 'horse': use one of auto, biped, quadruped, free-form"):
+        predict.chosen_template(votes_with({"biped": 1.0, "quadruped": 0.0, "other": 0.0}), "horse")
+
+
+def test_the_human_metarig_takes_the_skeletons_bones_and_a_heel_behind_each_ankle():
+    vertices, points = generated_landmarks(BIPED)
+    skeleton = biped_skeleton(symmetrised(points, True), vertices)
+    kind, placement, removed = metarig_placement(skeleton)
+    index = {name: k for k, name in enumerate(skeleton.names)}
+    assert kind == BIPED and set(removed) == {"breast.L", "breast.R", "pelvis.L", "pelvis.R"}
+    np.testing.assert_array_equal(placement["forearm.L"][0], skeleton.joints[index["forearm.L"]])
+    # Rigify's neck and head: spine.004 and spine.005 halve our neck, spine.006 is our head.
+    np.testing.assert_allclose(placement["spine.004"][0], skeleton.joints[index["neck"]])
+    np.testing.assert_allclose(placement["spine.005"][1], skeleton.joints[index["head"]])
+    np.testing.assert_allclose(placement["spine.006"][1], skeleton.tails[index["head"]])
+    heel_start, heel_end = placement["heel.02.L"]
+    ankle = skeleton.joints[index["foot.L"]]
+    assert heel_start[0] < ankle[0] < heel_end[0]  # across the foot, inside to outside
+    assert heel_start[1] > ankle[1] and heel_start[2] == pytest.approx(skeleton.tails[index["toe.L"], 2])
+    right_start, right_end = placement["heel.02.R"]
+    np.testing.assert_allclose(right_start * [-1, 1, 1], heel_start, atol=1e-12)
+
+
+def test_the_quadruped_metarig_keeps_its_tail_only_when_there_is_one():
+    vertices, points = generated_landmarks(QUADRUPED)
+    skeleton = quadruped_skeleton(symmetrised(points, True), vertices)
+    kind, placement, removed = metarig_placement(skeleton)
+    assert kind == QUADRUPED and "spine.003" in placement and "spine.003" not in removed
+    tailless = Skeleton(skeleton.joints, skeleton.parents,
+                        tuple(name.replace("tail", "fin") for name in skeleton.names), skeleton.tails)
+    _, placement, removed = metarig_placement(tailless)
+    assert {"spine", "spine.001", "spine.002", "spine.003"} <= set(removed) and "spine.003" not in placement
+    with pytest.raises(InputError, match="Rigify needs a standard biped or quadruped skeleton"):
+        metarig_placement(Skeleton(np.zeros((2, 3)), np.array([-1, 0]), ("root", "limb.L")))
