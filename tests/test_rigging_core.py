@@ -582,8 +582,13 @@ def turned_prediction(direction: int):
 @pytest.mark.parametrize("direction", [FACING_PLUS_X, FACING_MINUS_X], ids=["facing +X", "facing -X"])
 def test_a_character_facing_x_is_noted_and_turned_for_the_prediction(direction):
     _, mesh, votes, skeleton = turned_prediction(direction)
-    assert votes.notes == ("The character faces +-X; it was turned a quarter for the prediction (its mirror plane "
-                           "is x = 0 of its own space).",)
+    assert votes.notes[0] == ("The character faces +-X; it was turned a quarter for the prediction (its mirror "
+                              "plane is x = 0 of its own space).")
+    # The quarter turn that finds the mirror plane turns a character facing +X to face +Y; its feet tell, and
+    # it is turned on to face -Y.
+    half_turn = ("The character faces away from -Y (turned, it reads as a biped); it was turned half a turn for the "
+                 "prediction, so its .L bones lie on its own left.")
+    assert votes.notes[1:] == ((half_turn,) if direction == FACING_PLUS_X else ())
     assert votes.symmetric
     assert_well_formed(skeleton, mesh)
 
@@ -640,3 +645,36 @@ def test_a_leaf_is_never_cut_below_the_shortest_bone():
     joints = np.array([[0.0, 0.0, 0.9], [0.0, 0.0, 1.2]])
     tails = predict.leaf_tails_inside(joints, np.array([-1, 0]), np.array([[0.0, 0.0, 1.2], [0.0, 0.0, 1.5]]), solid)
     assert tails[1, 2] - 1.2 == pytest.approx(predict.LONE_BONE_LENGTH)
+
+
+def test_a_biped_facing_plus_y_is_turned_so_its_left_bones_are_on_its_left():
+    rotation = quarter_turn(2) @ quarter_turn(2)  # half a turn: facing +Y, its left at -X
+    character = generate_character(BIPED_SEED, "biped")
+    mesh = Mesh(placed(character.mesh.vertices, rotation), character.mesh.triangles)
+    votes = predict.predict_votes(mesh)
+    assert any(note.startswith("The character faces away from -Y") for note in votes.notes)
+    skeleton = predict.skeleton_from_votes(votes, template="biped")
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    left = rotation @ [1.0, 0.0, 0.0]
+    for role in ("upper_arm", "hand", "thigh", "foot"):
+        assert (skeleton.joints[names[role + LEFT_SUFFIX]] - skeleton.joints[names[role + RIGHT_SUFFIX]]) @ left > 0
+    # The toes point where the character faces.
+    forward = rotation @ [0.0, -1.0, 0.0]
+    assert (skeleton.tails[names["toe.L"]] - skeleton.joints[names["foot.L"]]) @ forward > 0
+
+
+#: A procedural quadruped the landmark network reads as one (the generator's seed 0 quadruped it reads as a biped).
+QUADRUPED_SEED = 3
+
+
+@pytest.mark.parametrize("turn", [1, -1, 2], ids=["facing +X", "facing -X", "facing +Y"])
+def test_a_quadruped_facing_any_way_gets_its_head_forward(turn):
+    rotation = np.linalg.matrix_power(quarter_turn(2, 1 if turn > 0 else -1), abs(turn))
+    character = generate_character(QUADRUPED_SEED, "quadruped")
+    mesh = Mesh(placed(character.mesh.vertices, rotation), character.mesh.triangles)
+    skeleton = predict.skeleton_from_votes(predict.predict_votes(mesh), template="quadruped")
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    forward = rotation @ [0.0, -1.0, 0.0]
+    assert (skeleton.joints[names["head"]] - skeleton.joints[names["spine"]]) @ forward > 0
+    left = rotation @ [1.0, 0.0, 0.0]
+    assert (skeleton.joints[names["thigh.L"]] - skeleton.joints[names["thigh.R"]]) @ left > 0

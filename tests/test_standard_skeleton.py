@@ -16,6 +16,7 @@ from autorig_addon.core.rigging.standard_skeleton import (
     SYMMETRIC_PAIR_DISTANCE,
     Landmarks,
     biped_skeleton,
+    landmark_warnings,
     quadruped_skeleton,
     symmetrised,
 )
@@ -167,3 +168,22 @@ def test_the_quadruped_metarig_keeps_its_tail_only_when_there_is_one():
     assert {"spine", "spine.001", "spine.002", "spine.003"} <= set(removed) and "spine.003" not in placement
     with pytest.raises(InputError, match="Rigify needs a standard biped or quadruped skeleton"):
         metarig_placement(Skeleton(np.zeros((2, 3)), np.array([-1, 0]), ("root", "limb.L")))
+
+
+def test_warnings_name_key_joints_outside_the_body_and_a_leg_out_of_order():
+    points = {name: np.array([0.0, 0.0, 0.5]) for name in LANDMARKS}
+    points.update({"hip.L": np.array([0.1, 0.0, 0.5]), "knee.L": np.array([0.1, 0.0, 0.3]),
+                   "ankle.L": np.array([0.1, 0.0, 0.05]), "hip.R": np.array([-0.1, 0.0, 0.5]),
+                   "knee.R": np.array([-0.1, 0.0, 0.05]), "ankle.R": np.array([-0.1, 0.0, 0.3]),
+                   "wrist.L": np.array([0.9, 0.0, 0.5])})
+    landmarks = Landmarks(points, {"biped": 1.0, "quadruped": 0.0, "other": 0.0})
+
+    def inside(query):  # a box body from x = -0.5 to 0.5
+        return np.where(np.abs(query[:, 0]) <= 0.5, 0.1, 0.0)
+
+    assert landmark_warnings(landmarks, BIPED, inside) == (
+        "check the skeleton: the left wrist could not be placed inside the body",
+        "check the skeleton: the right hip joint, right knee and right ankle do not go down the leg in order",
+    )
+    quadruped = landmark_warnings(landmarks, QUADRUPED, inside)
+    assert quadruped[0] == "check the skeleton: the left front ankle could not be placed inside the body"

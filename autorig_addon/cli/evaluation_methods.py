@@ -222,11 +222,11 @@ def _nearest_character(mesh) -> RigPrediction:
 
 
 def _rignet_skeleton(mesh, template: str = "auto") -> RigPrediction:
-    from ..core.rigging.predict import chosen_template, predict_votes, skeleton_from_votes
+    from ..core.rigging.predict import predict_votes, skeleton_from_votes, template_notes
 
     votes = predict_votes(mesh)
-    return RigPrediction(skeleton_from_votes(votes, template=template),
-                         (*votes.notes, chosen_template(votes, template)[1]))
+    skeleton = skeleton_from_votes(votes, template=template)
+    return RigPrediction(skeleton, (*votes.notes, *template_notes(votes, template)))
 
 
 def _closest_point_transfer(source, source_weights, target):

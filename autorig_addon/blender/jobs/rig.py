@@ -37,7 +37,14 @@ from ...core.errors import InputError
 from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
-from ...core.rigging.predict import JointVotes, chosen_template, naming_note, predict_votes, skeleton_from_votes
+from ...core.rigging.predict import (
+    JointVotes,
+    chosen_template,
+    naming_note,
+    predict_votes,
+    skeleton_from_votes,
+    template_notes,
+)
 from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
 from ...core.types import Mesh, Skeleton
@@ -220,8 +227,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     created = [armature]
     try:
         armature.show_in_front = True  # the bones are inside the body
-        template, template_note = chosen_template(votes, **_template(plan.settings))
-        notes = (*votes.notes, template_note)
+        template = chosen_template(votes, **_template(plan.settings))[0]
+        notes = (*votes.notes, *template_notes(votes, **_template(plan.settings)))
         if plan.settings.names is not None and naming_note(skeleton, plan.settings.names):
             notes = (*notes, naming_note(skeleton, plan.settings.names))
         target = armature

@@ -47,6 +47,9 @@ from .standard_skeleton import (
     KIND_CONFIDENCE,
     TEMPLATES,
     Landmarks,
+    faces_backward,
+    half_turned,
+    landmark_warnings,
     predict_landmarks,
     standard_skeleton,
 )
@@ -197,18 +200,40 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         transform = normalisation_transform(proxy.vertices, turns)
         notes.append("The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 "
                      "of its own space).")
+    graph, solid, landmarks = _read_shape(proxy, transform, progress)
+    if faces_backward(landmarks, graph.vertices, predict_landmarks(half_turned(graph))):
+        # Turned half a turn the character faces -y as the networks expect, its left at +x.
+        turns += 2
+        transform = normalisation_transform(proxy.vertices, turns)
+        graph, solid, landmarks = _read_shape(proxy, transform, progress)
+        notes.append(f"The character faces away from -Y (turned, it reads as a {landmarks.kind}); it was turned half "
+                     "a turn for the prediction, so its .L bones lie on its own left.")
+    report(progress, 0.7, "Running the joint network")
+    votes = graph_votes(weights, graph, solid, transform)
+    if not votes.symmetric:
+        notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
+    report(progress, 1.0, "Joint votes done")
+    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices)
+
+
+def _read_shape(proxy: Mesh, transform: np.ndarray, progress) -> tuple:
+    """The normalised proxy's joint graph, solid and landmarks."""
     normalised = Mesh(apply_transform(proxy.vertices, transform), proxy.triangles)
     report(progress, 0.3, "Measuring the shape")
     solid = solid_depth(normalised)
     graph = joint_graph(normalised, solid)
-    report(progress, 0.6, "Running the joint network")
-    votes = graph_votes(weights, graph, solid, transform)
-    if not votes.symmetric:
-        notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
-    report(progress, 0.8, "Running the landmark network")
-    landmarks = predict_landmarks(graph)
-    report(progress, 1.0, "Joint votes done")
-    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices)
+    report(progress, 0.5, "Running the landmark network")
+    return graph, solid, predict_landmarks(graph)
+
+
+def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple:
+    """The report's notes on the template: which one and why
+    (:func:`chosen_template`), then what looks wrong with a standard
+    skeleton (:func:`.standard_skeleton.landmark_warnings`)."""
+    kind, note = chosen_template(votes, template)
+    if kind == FREE_FORM or votes.solid is None:
+        return (note,)
+    return (note, *landmark_warnings(votes.landmarks, kind, votes.solid.at))
 
 
 def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple[str, str]:

@@ -29,7 +29,7 @@ facing -y, left at +x).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,7 +38,7 @@ from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
 from ..types import Skeleton
-from .joint_features import JointGraph
+from .joint_features import VERTEX_VECTORS, JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
 
@@ -113,6 +113,55 @@ def symmetrised(points: dict, symmetric_shape: bool) -> dict:
             mean[0] = abs(mean[0])
             points[name], points[twin] = mean, mean * flip
     return points
+
+
+#: A biped faces +y when its feet reach this many times as far behind the
+#: ankles as ahead of them (toes point forward: a foot reaches about three
+#: times as far ahead of the ankle as behind it).
+BACKWARD_FEET_RATIO = 1.5
+
+
+#: Turned half a turn, a character is taken to face the other way when the
+#: landmark network is at least this much surer there that it is a biped or
+#: a quadruped (it learnt bodies facing -y: a dog facing +y reads as "other").
+TURNED_CONFIDENCE_GAIN = 0.25
+
+
+def half_turned(graph: JointGraph) -> JointGraph:
+    """The graph of the character turned half a turn about the vertical axis
+    through its box centre (x = y = 0 of the normalised frame): the x and y
+    of every position and direction change sign; depths and edges stay."""
+    flip = np.ones(graph.vertex_features.shape[1], dtype=graph.vertex_features.dtype)
+    for start in VERTEX_VECTORS:
+        flip[start:start + 2] = -1
+    return replace(graph, vertices=graph.vertices * np.array([-1.0, -1.0, 1.0]),
+                   vertex_features=graph.vertex_features * flip)
+
+
+def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks | None = None) -> bool:
+    """Whether the character faces +y instead of -y (normalised frame): the
+    landmark network reads it much more surely as a biped or quadruped when
+    turned half a turn (``turned``, its landmarks on :func:`half_turned`), or
+    a biped's feet reach behind its ankles. Only a clear case counts."""
+    if turned is not None and _standard_confidence(turned) >= _standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
+        return True
+    points = landmarks.points
+    if landmarks.kind != BIPED:
+        return False
+    ahead = behind = 0.0
+    for side in (LEFT, RIGHT):
+        ankle = points["ankle" + side]
+        radius = max(0.5 * abs(points["hip" + side][0]), 0.03)
+        foot = vertices[(vertices[:, 2] <= ankle[2]) & (np.abs(vertices[:, 0] - ankle[0]) <= radius)
+                        & (np.abs(vertices[:, 1] - ankle[1]) <= 4.0 * radius)]
+        if len(foot):
+            ahead += max(ankle[1] - float(foot[:, 1].min()), 0.0)
+            behind += max(float(foot[:, 1].max()) - ankle[1], 0.0)
+    return behind > BACKWARD_FEET_RATIO * ahead and behind > 0.0
+
+
+def _standard_confidence(landmarks: Landmarks) -> float:
+    return max(landmarks.kind_probabilities[BIPED], landmarks.kind_probabilities[QUADRUPED])
 
 
 class _Builder:
@@ -234,6 +283,52 @@ def quadruped_skeleton(points: dict, vertices: np.ndarray) -> Skeleton:
         build.chain(["thigh" + side, "shin" + side, "foot" + side, "toe" + side], [hip, knee, ankle, ball, tip],
                     "spine")
     return build.skeleton()
+
+
+#: How the checks of :func:`landmark_warnings` name each key joint.
+SPOKEN_NAMES = {"hips": "hips", "neck": "neck", "head": "head", "shoulder": "shoulder", "elbow": "elbow",
+                "wrist": "wrist", "hip": "hip joint", "knee": "knee", "ankle": "ankle"}
+
+
+def _spoken(landmark: str, kind: str) -> str:
+    base, _, side = landmark.partition(".")
+    side = {"L": "left ", "R": "right "}.get(side, "")
+    if kind == QUADRUPED and base in ("shoulder", "elbow", "wrist"):
+        base = {"shoulder": "front hip joint", "elbow": "front knee", "wrist": "front ankle"}[base]
+    return side + SPOKEN_NAMES.get(base, base)
+
+
+def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
+    """What looks wrong with the landmarks of a standard skeleton, as notes.
+
+    Parameters
+    ----------
+    landmarks : Landmarks
+    kind : ``biped`` or ``quadruped``
+    inside : callable, ``(k, 3) points -> (k,) depth`` of the character's
+        solid (``SolidDepth.at``); a key joint at depth 0 lies outside the body
+
+    Returns
+    -------
+    tuple of str: key joints outside the body, and a leg whose joints do not
+    go down from the hip to the ankle.
+    """
+    names = list(landmarks.points)
+    points = np.array([landmarks.points[name] for name in names])
+    depth = np.asarray(inside(points)).reshape(-1)
+    notes = []
+    outside = [_spoken(name, kind) for name, value in zip(names, depth) if value <= 0.0]
+    if outside:
+        notes.append(f"check the skeleton: the {', '.join(outside)} could not be placed inside the body")
+    legs = [("hip", "knee", "ankle")] + ([("shoulder", "elbow", "wrist")] if kind == QUADRUPED else [])
+    for chain in legs:
+        for side in (LEFT, RIGHT):
+            heights = [landmarks.points[role + side][2] for role in chain]
+            if not heights[0] > heights[1] > heights[2]:
+                notes.append(f"check the skeleton: the {_spoken(chain[0] + side, kind)}, "
+                             f"{_spoken(chain[1] + side, kind)} and {_spoken(chain[2] + side, kind)} do not go "
+                             "down the leg in order")
+    return tuple(notes)
 
 
 def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool) -> Skeleton:
