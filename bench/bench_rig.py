@@ -13,12 +13,18 @@ weights files), each step runs ``--repeat`` times:
 
 * ``predict_votes``: proxy, normalisation, depth features, joint network
   (the slow part, once per character);
-* ``skeleton_from_votes`` at :data:`BANDWIDTHS` (what the level-of-detail
-  slider re-runs: clustering, connectivity, names), with the joint count;
-* ``predict_skeleton``: both, as *Predict Skeleton* runs them;
+* ``skeleton_from_votes`` of the free-form skeleton at :data:`BANDWIDTHS`
+  (what the level-of-detail slider re-runs: clustering, connectivity,
+  names), with the joint count;
+* ``predict_skeleton``: both, as *Predict Skeleton* runs them with the
+  default template (the standard skeleton when the landmark network reads a
+  biped or quadruped), and with the free-form template;
 * on ``5k`` only, the auto-rig core path: ``predict_skeleton`` then
   ``core.skinning.methods.skin_weights`` with the default method, as
-  *Auto-Rig* runs them (without Blender's armature and vertex-group writes).
+  *Auto-Rig* runs them (without Blender's armature and vertex-group writes);
+  and the whole *Auto-Rig* with Rigify in Blender (``blender.jobs.rig``:
+  armature, Rigify's metarig and generation, learned skin written into
+  vertex groups), on a mesh object made from the arrays.
 
 The table gives the median seconds, the fastest and slowest run, the peak
 resident memory one call added (largest over the runs,
@@ -58,6 +64,24 @@ def auto_rig(mesh):
     return skeleton, skin_weights(mesh, skeleton, SkinningOptions(method=DEFAULT_SKIN_METHOD))
 
 
+def blender_auto_rig_with_rigify(mesh):
+    """Auto-Rig with Rigify on a fresh scene holding the mesh; returns the control rig's skeleton."""
+    import bpy
+
+    from autorig_addon.blender.jobs.rig import RigSettings, plan_rig, rig_steps, run_steps
+    from autorig_addon.blender.jobs.skin import SkinSettings
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    data = bpy.data.meshes.new("Character")
+    data.from_pydata(mesh.vertices.tolist(), [], mesh.triangles.tolist())
+    obj = bpy.data.objects.new("Character", data)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    plan = plan_rig([obj], bpy.context.evaluated_depsgraph_get(), "Character", RigSettings(template="biped"),
+                    skin=SkinSettings(SkinningOptions(method=DEFAULT_SKIN_METHOD)), rigify=True)
+    return run_steps(rig_steps(bpy.context, plan, remember=False)).skeleton
+
+
 def measured(function, seconds: list, peaks: dict, key: str):
     """Run ``function()``, append its seconds, keep the largest peak memory; return its result."""
     rss = _status_mib("VmRSS:")
@@ -76,10 +100,13 @@ def measured(function, seconds: list, peaks: dict, key: str):
 
 def run_size(folder: str, size: str, repeat: int) -> dict:
     mesh, _, _ = character(folder, size)
-    steps = ["predict_votes"] + [f"skeleton_from_votes h={h:g}" for h in BANDWIDTHS] + ["predict_skeleton"]
+    steps = (["predict_votes"] + [f"skeleton_from_votes free-form h={h:g}" for h in BANDWIDTHS]
+             + ["predict_skeleton", "predict_skeleton free-form"])
+    rigify_step = f"Auto-Rig with Rigify in Blender ({DEFAULT_SKIN_METHOD} skin)"
     if size in AUTO_RIG_SIZES:
-        steps.append(f"auto-rig (predict_skeleton + skin_weights {DEFAULT_SKIN_METHOD})")
+        steps += [f"auto-rig (predict_skeleton + skin_weights {DEFAULT_SKIN_METHOD})", rigify_step]
         auto_rig(mesh)  # first call reads every weights file; not timed
+        blender_auto_rig_with_rigify(mesh)  # loads Rigify
     else:
         predict.predict_skeleton(mesh)
     seconds = {step: [] for step in steps}
@@ -87,15 +114,18 @@ def run_size(folder: str, size: str, repeat: int) -> dict:
     for _ in range(repeat):
         votes = measured(lambda: predict.predict_votes(mesh), seconds[steps[0]], peaks, steps[0])
         for bandwidth, step in zip(BANDWIDTHS, steps[1:]):
-            skeleton = measured(lambda: predict.skeleton_from_votes(votes, bandwidth=bandwidth), seconds[step], peaks,
-                                step)
+            skeleton = measured(lambda: predict.skeleton_from_votes(votes, bandwidth=bandwidth, template="free-form"),
+                                seconds[step], peaks, step)
             joints[step] = skeleton.bone_count
-        skeleton = measured(lambda: predict.predict_skeleton(mesh), seconds["predict_skeleton"], peaks,
-                            "predict_skeleton")
-        joints["predict_skeleton"] = skeleton.bone_count
+        for step, template in (("predict_skeleton", "auto"), ("predict_skeleton free-form", "free-form")):
+            skeleton = measured(lambda: predict.predict_skeleton(mesh, template=template), seconds[step], peaks, step)
+            joints[step] = skeleton.bone_count
         if size in AUTO_RIG_SIZES:
-            skeleton, _ = measured(lambda: auto_rig(mesh), seconds[steps[-1]], peaks, steps[-1])
-            joints[steps[-1]] = skeleton.bone_count
+            step = steps[-2]
+            skeleton, _ = measured(lambda: auto_rig(mesh), seconds[step], peaks, step)
+            joints[step] = skeleton.bone_count
+            skeleton = measured(lambda: blender_auto_rig_with_rigify(mesh), seconds[rigify_step], peaks, rigify_step)
+            joints[rigify_step] = skeleton.bone_count
     return {"size": size, "vertices": mesh.vertex_count, "objects": len(mesh.object_names), "steps": {
         step: {"median_s": statistics.median(seconds[step]), "min_s": min(seconds[step]), "max_s": max(seconds[step]),
                "joints": joints.get(step), "added_mib": peaks[step][0], "total_mib": peaks[step][1]}

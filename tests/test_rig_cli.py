@@ -180,3 +180,35 @@ def test_rigify_with_the_free_form_template_is_refused(clean_scene, tmp_path, ca
     assert code == 1
     assert json.loads(stdout)["failed"][0]["error"] == ("Rigify needs a standard skeleton: choose the Auto, Biped or "
                                                        "Quadruped template.")
+
+
+def save_two_far_parts(path):
+    """A post and a block three heights away from it, saved as one character."""
+    from geometry_fixtures import box_mesh
+
+    reset_scene()
+    post, block = box_mesh([-0.1, -0.1, 0.0], [0.1, 0.1, 1.0], 0.05), box_mesh([3.0, -0.1, 0.0], [3.2, 0.1, 0.3], 0.05)
+    vertices = np.vstack([post.vertices, block.vertices])
+    mesh_object("Parts", vertices, np.vstack([post.triangles, block.triangles + len(post.vertices)]))
+    bpy.context.view_layer.update()
+    scene_io.save_scene(path)
+
+
+def test_a_poor_skeleton_fails_with_the_reason_unless_kept(clean_scene, tmp_path, capsys):
+    source, out = tmp_path / "parts.blend", tmp_path / "rigged.blend"
+    save_two_far_parts(source)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--template", "free-form", "--quiet"], capsys)
+
+    assert code == 1 and not out.exists()
+    error = json.loads(stdout)["failed"][0]["error"]
+    assert error.startswith("The predicted skeleton looks poor: ") and "lies mostly outside the body" in error
+    assert error.endswith("keep it anyway with Keep Poor Result (--keep-poor).")
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--template", "free-form", "--keep-poor",
+                                "--quiet"], capsys)
+
+    assert code == 0 and out.exists()
+    (item,) = json.loads(stdout)["succeeded"]
+    assert item["problems"] and all("outside the body" in problem for problem in item["problems"])
+    assert any(note.startswith("poor result kept: ") for note in item["notes"])

@@ -41,6 +41,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "skeleton and bind the meshes to its DEF- bones (needs a biped or quadruped: the "
                              "template auto recognising one, or --template biped/quadruped); the metarig stays in "
                              "the file, hidden")
+    parser.add_argument("--keep-poor", action="store_true",
+                        help="Keep a skeleton the checks find poor (a bone outside the body, legs not hanging from the "
+                             "hips, ...) and list what they found in the summary (default: the file fails with the "
+                             "reason and nothing is written)")
     parser.add_argument("--replace", action="store_true",
                         help="Rig a file that already holds an armature: remove it, the meshes' Armature modifiers "
                              "and their groups named after its bones first (default: such a file is refused)")
@@ -94,13 +98,14 @@ def run(args: argparse.Namespace) -> int:
         if not meshes:
             raise InputError("The file holds no mesh to rig.")
         plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), Path(input_path).stem, settings,
-                        skin=skin, named=False, rigify=args.rigify)
+                        skin=skin, named=False, rigify=args.rigify, keep_poor=args.keep_poor)
         result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)
         details = {"armature": result.armature.name, "bones": result.skeleton.bone_count,
                    "meshes": [obj.name for obj in plan.meshes], "skin": args.skin, "template": result.template,
-                   "body": result.body, "confidence": round(result.confidence, 3), "rigify": result.rigify}
+                   "body": result.body, "confidence": round(result.confidence, 3), "rigify": result.rigify,
+                   "problems": list(result.problems)}
         if removed:
             details["replaced"] = removed
         notes = list(result.notes) + (result.skin_plan.notes if result.skin_plan is not None else [])

@@ -43,6 +43,7 @@ from ...core.rigging.predict import (
     naming_note,
     predict_votes,
     skeleton_from_votes,
+    skeleton_quality,
     template_notes,
 )
 from ...core.rigging.standard_skeleton import FREE_FORM
@@ -116,6 +117,7 @@ class RigPlan:
         that armature afterwards when nothing else follows it
     named : bool, the user picked the meshes (False: every mesh of a file; see ``plan_skin``)
     rigify : bool, turn the standard skeleton into Rigify's control rig and bind the meshes to its DEF- bones
+    keep_poor : bool, build a skeleton the checks find poor (``core.rigging.quality``) instead of refusing it
     """
 
     meshes: list
@@ -126,6 +128,7 @@ class RigPlan:
     replace: bool = False
     named: bool = True
     rigify: bool = False
+    keep_poor: bool = False
 
 
 @dataclass
@@ -134,7 +137,9 @@ class RigResult:
     prediction and, when it bound the meshes, the skin plan and weights;
     ``template`` is the skeleton built (``biped``, ``quadruped`` or
     ``free-form``), ``body`` and ``confidence`` what the landmark network
-    read the body as and how sure it was, ``rigify`` whether Rigify's control rig was generated."""
+    read the body as and how sure it was, ``rigify`` whether Rigify's control
+    rig was generated, ``problems`` what the checks found in a poor skeleton
+    kept on request."""
 
     armature: object
     skeleton: Skeleton
@@ -145,6 +150,7 @@ class RigResult:
     body: str = ""
     confidence: float = 0.0
     rigify: bool = False
+    problems: tuple = ()
 
 
 @dataclass
@@ -161,7 +167,7 @@ _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
              skin: SkinSettings | None = None, replace: bool = False, named: bool = True,
-             rigify: bool = False) -> RigPlan:
+             rigify: bool = False, keep_poor: bool = False) -> RigPlan:
     """Read and check the character's meshes; raises :class:`InputError` on bad input.
 
     Parameters
@@ -173,7 +179,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     skin : SkinSettings or None; given, the meshes are bound, and a mesh
         already bound to an armature is refused unless ``replace``
     replace : bool
-    named, rigify : bool, see :class:`RigPlan`
+    named, rigify, keep_poor : bool, see :class:`RigPlan`
     """
     meshes = list(dict.fromkeys(meshes))
     if not meshes:
@@ -193,7 +199,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
-    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify)
+    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor)
 
 
 def _remember(armature, votes: JointVotes) -> None:
@@ -222,13 +228,18 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
     votes = yield lambda progress: predict_votes(plan.mesh, sub_progress(progress, 0.0, share))
     skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
+    problems = skeleton_quality(votes, skeleton)
+    if problems and not plan.keep_poor:
+        raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
+                         "Template, or keep it anyway with Keep Poor Result (--keep-poor).")
     replaced = _followed_armatures(plan.meshes) if plan.skin is not None and plan.replace else []
     armature = build_armature(skeleton, plan.name, context)
     created = [armature]
     try:
         armature.show_in_front = True  # the bones are inside the body
         template = chosen_template(votes, **_template(plan.settings))[0]
-        notes = (*votes.notes, *template_notes(votes, **_template(plan.settings)))
+        notes = (*votes.notes, *template_notes(votes, **_template(plan.settings)),
+                 *(f"poor result kept: {problem}" for problem in problems))
         if plan.settings.names is not None and naming_note(skeleton, plan.settings.names):
             notes = (*notes, naming_note(skeleton, plan.settings.names))
         target = armature
@@ -243,7 +254,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 created += [rig, metarig]
                 target, notes = rig, (*notes, *rigify_notes)
         result = RigResult(target, convert.read_skeleton(target) if rig is not None else skeleton, notes,
-                           template=template, rigify=rig is not None)
+                           template=template, rigify=rig is not None, problems=problems)
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
         if plan.skin is not None:

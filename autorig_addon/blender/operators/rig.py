@@ -9,7 +9,7 @@ from __future__ import annotations
 import bpy
 
 from ...core.errors import Cancelled, InputError
-from ...core.rigging.options import REPLACE_BINDING, RIGIFY
+from ...core.rigging.options import KEEP_POOR, REPLACE_BINDING, RIGIFY
 from ..jobs.input_checks import mode_poll
 from ..jobs.rig import RigPlan, RigResult, TaskJob, plan_rig, rig_steps, run_steps
 from ..jobs.skin import SkinSettings
@@ -39,6 +39,8 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
     bl_options = {"REGISTER", "UNDO"}
     binds = False
 
+    rig_keep_poor: option_property(KEEP_POOR)
+
     _steps = None
 
     @classmethod
@@ -46,7 +48,7 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
         return mode_poll(cls, context, cls.bl_label)
 
     def option_names(self) -> tuple:
-        return RIG_OPTION_NAMES
+        return RIG_OPTION_NAMES + ("rig_keep_poor",)
 
     def skin_settings(self) -> SkinSettings | None:
         return None
@@ -56,7 +58,7 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
         name = character_name(meshes, context.active_object) if meshes else ""
         return plan_rig(meshes, context.evaluated_depsgraph_get(), name, rig_settings_from(self),
                         skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)),
-                        rigify=bool(getattr(self, "rig_rigify", False)))
+                        rigify=bool(getattr(self, "rig_rigify", False)), keep_poor=self.rig_keep_poor)
 
     def invoke(self, context, event):
         for name, value in scene_values(context, self.option_names(), self.properties.is_property_set).items():
@@ -155,7 +157,7 @@ class AUTORIG_OT_auto_rig(_RigOperator, SkinOptionProperties, bpy.types.Operator
     rig_rigify: option_property(RIGIFY)
 
     def option_names(self) -> tuple:
-        return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace", "rig_rigify")
+        return RIG_OPTION_NAMES + SKIN_OPTION_NAMES + ("rig_replace", "rig_rigify", "rig_keep_poor")
 
     def skin_settings(self) -> SkinSettings:
         return skin_settings_from(self)

@@ -156,6 +156,7 @@ class VIEW3D_PT_autorig_rig(_AutoRigSubPanel, bpy.types.Panel):
         detail.prop(settings, "rig_bandwidth")
         detail.prop(settings, "rig_density_threshold")
         column.prop(settings, "rig_symmetry")
+        column.prop(settings, "rig_keep_poor")
         note, icon = live_note(context)
         if note:
             layout.label(text=note, icon=icon)

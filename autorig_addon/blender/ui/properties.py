@@ -16,7 +16,7 @@ from dataclasses import fields
 import bpy
 from bpy.props import PointerProperty
 
-from ...core.rigging.options import REPLACE_BINDING, RIG_OPTIONS, RIGIFY
+from ...core.rigging.options import KEEP_POOR, REPLACE_BINDING, RIG_OPTIONS, RIGIFY
 from ...core.skinning.options import SKINNING_OPTIONS, SkinningOptions
 from ...core.transfer.options import TRANSFER_OPTIONS, TransferOptions
 from ..jobs.rig import RigSettings, on_rig_setting_changed
@@ -83,6 +83,7 @@ class AutoRigSceneSettings(TransferOptionProperties, SkinOptionProperties, RigOp
 
     rig_replace: option_property(REPLACE_BINDING)
     rig_rigify: option_property(RIGIFY)
+    rig_keep_poor: option_property(KEEP_POOR)
 
     source: PointerProperty(
         name="Source",

@@ -1,8 +1,9 @@
 """Options of skeleton prediction: the clustering that turns the joint
 votes into a skeleton (:data:`RIG_OPTIONS`, the keywords of
 :func:`.predict.skeleton_from_votes`) and what Auto-Rig does with meshes
-already bound (:data:`REPLACE_BINDING`) and whether it builds Rigify's
-control rig (:data:`RIGIFY`). The Rig panel, the Predict
+already bound (:data:`REPLACE_BINDING`), whether it builds Rigify's
+control rig (:data:`RIGIFY`) and whether it keeps a poor skeleton
+(:data:`KEEP_POOR`). The Rig panel, the Predict
 Skeleton and Auto-Rig operators and ``python -m autorig_addon rig`` are
 made from them (``core.options``); defaults and bounds are
 :mod:`.predict`'s.
@@ -61,4 +62,13 @@ RIGIFY = Option(
     "rigify", bool, False, "Rigify Control Rig",
     "Build Rigify's control rig (IK/FK limbs, torso and head controls) from the standard skeleton and bind the "
     "meshes to its DEF- bones; needs the Biped or Quadruped template (or Auto recognising one)",
+    flag=None)
+
+#: Whether a skeleton the checks find poor (``core.rigging.quality``) is kept
+#: (with the problems in the report) instead of refused (the panel's and the
+#: operators'; the ``rig`` command's ``--keep-poor``).
+KEEP_POOR = Option(
+    "keep_poor", bool, False, "Keep Poor Result",
+    "Build the skeleton even when the checks find it poor (a bone outside the body, legs not hanging from the hips, "
+    "...); the report lists what they found. Otherwise nothing is built and the report says why",
     flag=None)

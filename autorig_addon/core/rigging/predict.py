@@ -40,6 +40,7 @@ from .connectivity import bone_probabilities, oriented_tree, root_scores, spanni
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
+from .quality import skeleton_problems
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
@@ -224,6 +225,17 @@ def _read_shape(proxy: Mesh, transform: np.ndarray, progress) -> tuple:
     graph = joint_graph(normalised, solid)
     report(progress, 0.5, "Running the landmark network")
     return graph, solid, predict_landmarks(graph)
+
+
+def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
+    """What an animator would reject in ``skeleton`` (the mesh's space), as
+    sentences (:func:`.quality.skeleton_problems`); empty when nothing, or
+    when the votes kept no solid to check against."""
+    if votes.solid is None or votes.proxy_vertices is None:
+        return ()
+    normalised = Skeleton(apply_transform(skeleton.joints, votes.transform), skeleton.parents, skeleton.names,
+                          apply_transform(skeleton.tails, votes.transform))
+    return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices)
 
 
 def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple:

@@ -1,0 +1,59 @@
+"""The checks that tell a poor skeleton before success is reported (core/rigging/quality.py)."""
+
+import numpy as np
+
+from autorig_addon.core.rigging.quality import FAR_FROM_SURFACE, skeleton_problems
+from autorig_addon.core.types import Skeleton
+
+#: A body: the box |x| <= 0.2, |y| <= 0.1, 0 <= z <= 1, its surface sampled on a grid.
+LOW, HIGH = np.array([-0.2, -0.1, 0.0]), np.array([0.2, 0.1, 1.0])
+GRID = np.stack(np.meshgrid(*[np.linspace(a, b, 9) for a, b in zip(LOW, HIGH)], indexing="ij"), -1).reshape(-1, 3)
+SURFACE = GRID[np.any(np.isclose(GRID, LOW) | np.isclose(GRID, HIGH), axis=1)]
+
+
+def depth(points):
+    inside = np.all((points >= LOW) & (points <= HIGH), axis=1)
+    return np.where(inside, np.min(np.minimum(points - LOW, HIGH - points), axis=1), 0.0)
+
+
+def biped(**moved):
+    """A stick biped inside the box; ``moved`` replaces joints by name."""
+    joints = {"spine": [0, 0, 0.5], "spine.001": [0, 0, 0.7], "neck": [0, 0, 0.85], "head": [0, 0, 0.9],
+              "upper_arm.L": [0.1, 0, 0.8], "upper_arm.R": [-0.1, 0, 0.8], "thigh.L": [0.08, 0, 0.45],
+              "thigh.R": [-0.08, 0, 0.45], "shin.L": [0.08, 0, 0.25], "shin.R": [-0.08, 0, 0.25]}
+    parents = {"spine": None, "spine.001": "spine", "neck": "spine.001", "head": "neck", "upper_arm.L": "spine.001",
+               "upper_arm.R": "spine.001", "thigh.L": "spine", "thigh.R": "spine", "shin.L": "thigh.L",
+               "shin.R": "thigh.R"}
+    parents.update({name: parent for name, (_, parent) in moved.items()})
+    joints.update({name: point for name, (point, _) in moved.items()})
+    names = list(joints)
+    return Skeleton(np.array([joints[n] for n in names], float),
+                    np.array([-1 if parents[n] is None else names.index(parents[n]) for n in names]), tuple(names))
+
+
+def test_a_sound_biped_has_no_problem():
+    assert skeleton_problems(biped(), depth, SURFACE) == ()
+
+
+def test_a_bone_to_a_point_far_from_the_body_is_named():
+    # A sword tip mirrored into the air: the forearm runs 1 unit out of the body.
+    skeleton = biped(**{"forearm.L": ([1.1, 0, 0.8], "upper_arm.L")})
+    assert skeleton_problems(skeleton, depth, SURFACE) == ("upper_arm.L lies mostly outside the body",)
+    # Just outside the surface (within FAR_FROM_SURFACE, an open shell's thickness) is not outside.
+    near = biped(**{"forearm.L": ([0.2 + FAR_FROM_SURFACE / 2, 0, 0.8], "upper_arm.L")})
+    assert skeleton_problems(near, depth, SURFACE) == ()
+
+
+def test_two_trees_a_long_bone_and_misplaced_limbs_are_named():
+    two_trees = biped(**{"thigh.L": ([0.08, 0, 0.45], None)})
+    assert "the skeleton is 2 separate trees, not one" in skeleton_problems(two_trees, depth, SURFACE)
+    long = Skeleton(np.array([[0.0, 0, 0.0]]), np.array([-1]), ("root",), np.array([[0.0, 0, 1.2]]))
+    assert skeleton_problems(long, lambda p: np.ones(len(p)), SURFACE) == ("root is longer than the body",)
+    # The Mannequin of the issue: legs hanging from the chest.
+    legs_from_chest = biped(**{"thigh.L": ([0.08, 0, 0.45], "spine.001"), "thigh.R": ([-0.08, 0, 0.45], "spine.001")})
+    assert skeleton_problems(legs_from_chest, depth, SURFACE) == ("the legs do not hang from the hips",)
+    arms_from_hips = biped(**{"upper_arm.L": ([0.1, 0, 0.8], "spine"), "upper_arm.R": ([-0.1, 0, 0.8], "spine")})
+    assert skeleton_problems(arms_from_hips, depth, SURFACE) == (
+        "the arms do not hang from the spine above the hips",)
+    head_down = biped(**{"head": ([0, 0, 0.3], "neck")})
+    assert "the head is not above the hips" in skeleton_problems(head_down, depth, SURFACE)
