@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..skeleton.hierarchy import ancestors
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names
 from ..types import Skeleton
 
@@ -48,18 +49,10 @@ def _listed(names: list) -> str:
     return shown + (f" and {len(names) - MAX_NAMED} more" if len(names) > MAX_NAMED else "")
 
 
-def _ancestors(parents: np.ndarray, joint: int) -> list:
-    found = []
-    while parents[joint] >= 0:
-        joint = int(parents[joint])
-        found.append(joint)
-    return found
-
-
 def _meeting_joint(parents: np.ndarray, first: int, second: int):
     """The nearest joint both chains hang from (their lowest common ancestor), or None."""
-    above_first = [first] + _ancestors(parents, first)
-    above_second = set([second] + _ancestors(parents, second))
+    above_first = [first] + ancestors(parents, first)
+    above_second = set([second] + ancestors(parents, second))
     return next((joint for joint in above_first if joint in above_second), None)
 
 
@@ -114,12 +107,12 @@ def _body_problems(skeleton: Skeleton) -> list:
     if all(leg in index for leg in legs):
         meeting = _meeting_joint(parents, index[legs[0]], index[legs[1]])
         # From the hips or a root below them; from the chest or from a foot, no.
-        if meeting is None or hips in _ancestors(parents, meeting):
+        if meeting is None or hips in ancestors(parents, meeting):
             problems.append("the legs do not hang from the hips")
     for arms in (("upper_arm.L", "upper_arm.R"), ("front_thigh.L", "front_thigh.R")):
         if all(arm in index for arm in arms):
             meeting = _meeting_joint(parents, index[arms[0]], index[arms[1]])
-            if meeting is None or meeting == hips or hips not in _ancestors(parents, meeting):
+            if meeting is None or meeting == hips or hips not in ancestors(parents, meeting):
                 problems.append(f"the {'arms' if arms[0].startswith('upper') else 'front legs'} do not hang from "
                                 "the spine above the hips")
     if "upper_arm.L" in index and "head" in index and skeleton.joints[index["head"], 2] <= skeleton.joints[hips, 2]:

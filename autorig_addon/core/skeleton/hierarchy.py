@@ -162,3 +162,19 @@ def subset_parents(parents, keep) -> np.ndarray:
     position[keep] = np.arange(np.count_nonzero(keep))
     kept_ancestors = nearest_kept[keep]
     return np.where(kept_ancestors >= 0, position[np.maximum(kept_ancestors, 0)], -1)
+
+
+def ancestors(parents, joint: int) -> list[int]:
+    """The joints above ``joint``, nearest first (its parent, the parent's parent, ... the root).
+
+    Examples
+    --------
+    >>> ancestors([-1, 0, 1, 0], 2)
+    [1, 0]
+    """
+    parents = _parent_array(parents)
+    found = []
+    while parents[joint] >= 0:
+        joint = int(parents[joint])
+        found.append(joint)
+    return found

@@ -27,6 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .hierarchy import ancestors
+
 #: Roles on the midline, then the roles every side has.
 MIDLINE_ROLES = ("hips", "neck", "head")
 SIDE_ROLES = ("shoulder", "elbow", "wrist", "hip", "knee", "ankle")
@@ -310,18 +312,10 @@ def key_joints(names, joints, left_direction=None, parents=None) -> KeyJoints:
 MIDLINE_SHARE = 0.25
 
 
-def _ancestors(parents: np.ndarray, joint: int) -> list:
-    found = []
-    while parents[joint] >= 0:
-        joint = int(parents[joint])
-        found.append(joint)
-    return found
-
-
 def _hips_the_legs_hang_from(found: dict, joints: np.ndarray, parents: np.ndarray) -> dict:
     left, right = found["hip" + LEFT], found["hip" + RIGHT]
     hips = found.get("hips")
-    if hips is not None and hips in _ancestors(parents, left):
+    if hips is not None and hips in ancestors(parents, left):
         return found
     root = leg_root(joints, parents, left, right)
     if root is None:
