@@ -156,3 +156,19 @@ def test_a_skeleton_that_is_not_a_standard_biped_is_not_renamed(clean_scene):
     with pytest.raises(RuntimeError, match="Only a standard biped skeleton can take engine bone names"):
         bpy.ops.autorig.rename_bones(preset="mixamo")
     assert [bone.name for bone in armature.data.bones] == ["root", "limb.L", "limb.R"]
+
+
+def test_generate_rigify_rig_from_the_operator_is_one_undo_step(clean_scene):
+    character = generate_character(BIPED_SEED, "biped")
+    obj = mesh_object("Biped", character.mesh.vertices, character.mesh.triangles)
+    bpy.context.view_layer.update()
+    select_only([obj], active=obj)
+    bpy.ops.ed.undo_push(message="before")
+    assert bpy.ops.autorig.auto_rig(rig_template="BIPED", rig_rigify=True, skin_method="GEOMETRIC") == {"FINISHED"}
+    # Background runs push no undo step of their own; Blender pushes this one after the operator.
+    bpy.ops.ed.undo_push(message="Auto-Rig")
+    rig = bpy.data.objects["Biped_rig"]
+    assert "DEF-forearm.L" in rig.data.bones and bpy.data.objects["Biped"].modifiers[0].object == rig
+    bpy.ops.ed.undo()
+    assert sorted(o.name for o in bpy.data.objects if o.type == "ARMATURE") == []
+    assert len(bpy.data.objects["Biped"].modifiers) == 0 and len(bpy.data.objects["Biped"].vertex_groups) == 0
