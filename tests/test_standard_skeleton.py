@@ -100,18 +100,23 @@ def test_the_quadruped_skeleton_has_front_and_hind_legs_and_a_tail():
     assert_mirrored(skeleton)
 
 
-def test_near_twin_landmarks_are_made_mirror_images_and_far_ones_are_kept():
+def test_landmarks_are_mirrored_on_a_nearly_symmetric_shape_and_near_twins_on_any():
     points = {"hips": np.array([0.01, 0.0, 0.5]), "shoulder.L": np.array([0.2, 0.0, 0.8]),
               "shoulder.R": np.array([-0.22, 0.02, 0.8]), "wrist.L": np.array([0.4, 0.0, 0.8]),
               "wrist.R": np.array([-0.2, 0.0, 0.4])}
-    result = symmetrised(points, symmetric_shape=True)
-    np.testing.assert_allclose(result["shoulder.L"], [0.21, 0.01, 0.8])
-    np.testing.assert_allclose(result["shoulder.R"], [-0.21, 0.01, 0.8])
-    # One arm raised far from its twin's mirror image stays as predicted.
+    for shape_symmetric in (True, False):
+        result = symmetrised(points, symmetric_shape=shape_symmetric)
+        np.testing.assert_allclose(result["shoulder.L"], [0.21, 0.01, 0.8])
+        np.testing.assert_allclose(result["shoulder.R"], [-0.21, 0.01, 0.8])
+    # On an asymmetric shape one arm raised far from its twin's mirror image stays as predicted.
     assert np.linalg.norm(points["wrist.L"] - points["wrist.R"] * [-1, 1, 1]) > SYMMETRIC_PAIR_DISTANCE
     np.testing.assert_array_equal(result["wrist.L"], points["wrist.L"])
-    assert result["hips"][0] == 0.0
-    assert symmetrised(points, symmetric_shape=False)["hips"][0] == 0.01
+    assert result["hips"][0] == 0.01
+    # On a nearly symmetric one (a held prop) every pair is mirrored and the midline is x = 0.
+    symmetric = symmetrised(points, symmetric_shape=True)
+    np.testing.assert_allclose(symmetric["wrist.L"], [0.3, 0.0, 0.6])
+    np.testing.assert_allclose(symmetric["wrist.R"], [-0.3, 0.0, 0.6])
+    assert symmetric["hips"][0] == 0.0
 
 
 def votes_with(kind_probabilities):

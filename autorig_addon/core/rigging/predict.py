@@ -46,6 +46,7 @@ from .standard_skeleton import (
     AUTO,
     FREE_FORM,
     KIND_CONFIDENCE,
+    NEAR_SYMMETRIC_ERROR,
     TEMPLATES,
     Landmarks,
     faces_backward,
@@ -345,7 +346,8 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     """
     kind, _ = chosen_template(votes, template)
     if kind != FREE_FORM:
-        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, votes.symmetric and symmetry)
+        nearly_symmetric = symmetry and mirror_error(votes.proxy_vertices, 0) <= NEAR_SYMMETRIC_ERROR
+        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric)
         to_mesh = np.linalg.inv(votes.transform)
         return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
                         preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))

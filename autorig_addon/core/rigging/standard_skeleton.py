@@ -17,11 +17,12 @@ Rigify's metarigs, named as :mod:`.role_names` names a recognised body:
   ``front_foot``, ``front_toe``; ``thigh``, ``shin``, ``foot``, ``toe``.
 
 Ends the landmarks do not give (top of the head, snout, feet and toes on
-the ground, hand, tail) are read from the mesh. Left and right landmarks are
-made mirror images of each other (averaged across x = 0) when they nearly
-are, so a character a little off symmetric (a held prop, one arm raised a
-few degrees) still gets a symmetric skeleton; midline landmarks are put on
-x = 0 when the shape is symmetric.
+the ground, hand, tail) are read from the mesh. On a nearly symmetric shape
+(:data:`NEAR_SYMMETRIC_ERROR`) left and right landmarks are made mirror
+images of each other (averaged across x = 0) and midline ones put on x = 0,
+so a character a little off symmetric (a held prop, one arm raised a few
+degrees) still gets a symmetric skeleton; on another, only pairs that
+nearly are mirror images are.
 
 Everything here is in the normalised frame (feet at z = 0, largest side 1,
 facing -y, left at +x).
@@ -49,9 +50,15 @@ TEMPLATES = (AUTO, BIPED, QUADRUPED, FREE_FORM)
 #: With ``auto``, a standard skeleton is built when the network gives its
 #: kind at least this probability; below it the free-form skeleton is kept.
 KIND_CONFIDENCE = 0.6
-#: Twin landmarks closer than this to each other's mirror image (share of
-#: the largest side) are made exactly symmetric.
+#: On a shape that is not nearly symmetric, twin landmarks closer than this
+#: to each other's mirror image (share of the largest side) are made exactly
+#: symmetric.
 SYMMETRIC_PAIR_DISTANCE = 0.08
+#: A shape whose mirror error (``symmetry.mirror_error``, share of the
+#: largest side) is at most this is nearly symmetric: every landmark pair is
+#: mirrored. Looser than the free-form skeleton's 0.02, so that a held prop
+#: or a weapon (Quaternius' Orc: 0.0245) still gives a symmetric skeleton.
+NEAR_SYMMETRIC_ERROR = 0.05
 #: Bones of the spine from the hips to the neck.
 SPINE_BONES = 4
 #: Bones of a tail.
@@ -97,8 +104,10 @@ def predict_landmarks(graph: JointGraph, weights: dict | None = None) -> Landmar
 
 
 def symmetrised(points: dict, symmetric_shape: bool) -> dict:
-    """Landmarks with near-twin pairs made mirror images and, on a symmetric
-    shape, the midline ones on x = 0."""
+    """Landmarks made mirror images: on a (nearly) symmetric shape every
+    left-right pair, and the midline ones put on x = 0; on another, only the
+    pairs already within :data:`SYMMETRIC_PAIR_DISTANCE` of each other's
+    mirror image (an arm raised on purpose keeps its place)."""
     points = {name: np.array(point, dtype=np.float64) for name, point in points.items()}
     flip = np.array([-1.0, 1.0, 1.0])
     for name in points:
@@ -108,7 +117,7 @@ def symmetrised(points: dict, symmetric_shape: bool) -> dict:
             continue
         twin = name[: -len(LEFT)] + RIGHT
         left, right = points[name], points[twin]
-        if np.linalg.norm(left - right * flip) <= SYMMETRIC_PAIR_DISTANCE:
+        if symmetric_shape or np.linalg.norm(left - right * flip) <= SYMMETRIC_PAIR_DISTANCE:
             mean = (left + right * flip) / 2.0
             mean[0] = abs(mean[0])
             points[name], points[twin] = mean, mean * flip
