@@ -20,6 +20,7 @@ BIPED_SEED = 0
 pytestmark = pytest.mark.all_blenders
 
 
+
 def auto_rig_biped(settings: RigSettings, rigify: bool = False):
     """The procedural biped auto-rigged with geometric skin."""
     character = generate_character(BIPED_SEED, "biped")
