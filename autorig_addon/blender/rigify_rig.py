@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import addon_utils
 import bpy
+from mathutils import Vector
 
 from ..core.errors import InputError
 from ..core.rigging.metarig import METARIGS, metarig_placement
@@ -110,7 +111,8 @@ def generate_rigify_rig(armature, name: str, context=None) -> tuple:
     try:
         metarig.matrix_world = armature.matrix_world.copy()
         inverse = armature.matrix_world.inverted()
-        local = {bone: (inverse @ _vector(head), inverse @ _vector(tail)) for bone, (head, tail) in placement.items()}
+        local = {bone: (inverse @ Vector(head.tolist()), inverse @ Vector(tail.tolist()))
+                 for bone, (head, tail) in placement.items()}
         _place_bones(metarig, local, removed, context)
         metarig.name = metarig.data.name = name + METARIG_SUFFIX
         for obj in context.view_layer.objects:
@@ -140,9 +142,3 @@ def generate_rigify_rig(armature, name: str, context=None) -> tuple:
         if previous_active is not None and previous_active.name in bpy.data.objects:
             context.view_layer.objects.active = previous_active
     return rig, metarig, notes
-
-
-def _vector(values):
-    from mathutils import Vector
-
-    return Vector(tuple(float(value) for value in values))

@@ -38,6 +38,7 @@ from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
 from ...core.rigging.predict import (
+    DEFAULT_TEMPLATE,
     JointVotes,
     chosen_template,
     naming_note,
@@ -48,6 +49,7 @@ from ...core.rigging.predict import (
 )
 from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
+from ...core.skeleton.name_presets import DEFAULT_PRESET
 from ...core.types import Mesh, Skeleton
 from .. import convert
 from ..armature_binding import armature_bindings, bound_armature, deforms, followers, remove_armature, unbind
@@ -96,10 +98,6 @@ class RigSettings:
     def keywords(self) -> dict:
         """The keyword arguments of ``skeleton_from_votes`` that were given."""
         return {name: value for name, value in vars(self).items() if value is not None}
-
-
-def _template(settings: RigSettings) -> dict:
-    return {"template": settings.template} if settings.template is not None else {}
 
 
 @dataclass
@@ -237,11 +235,10 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     created = [armature]
     try:
         armature.show_in_front = True  # the bones are inside the body
-        template = chosen_template(votes, **_template(plan.settings))[0]
-        notes = (*votes.notes, *template_notes(votes, **_template(plan.settings)),
+        template = plan.settings.template or DEFAULT_TEMPLATE
+        naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
+        notes = (*votes.notes, *template_notes(votes, template), *((naming,) if naming else ()),
                  *(f"poor result kept: {problem}" for problem in problems))
-        if plan.settings.names is not None and naming_note(skeleton, plan.settings.names):
-            notes = (*notes, naming_note(skeleton, plan.settings.names))
         target = armature
         rig = None
         if plan.rigify:
@@ -254,7 +251,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 created += [rig, metarig]
                 target, notes = rig, (*notes, *rigify_notes)
         result = RigResult(target, convert.read_skeleton(target) if rig is not None else skeleton, notes,
-                           template=template, rigify=rig is not None, problems=problems)
+                           template=chosen_template(votes, template)[0], rigify=rig is not None, problems=problems)
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
         if plan.skin is not None:

@@ -6,8 +6,11 @@ import bpy
 from bpy.props import EnumProperty
 
 from ...core.errors import InputError
-from ...core.skeleton.name_presets import DEFAULT_PRESET, PRESET_LABELS
+from ...core.skeleton.name_presets import DEFAULT_PRESET, PRESET_LABELS, PRESET_TITLES
 from ..bone_names import rename_bones
+
+#: The Names menu: (identifier, title, tooltip) per preset.
+PRESET_ITEMS = [(preset, PRESET_TITLES[preset], label) for preset, label in PRESET_LABELS.items()]
 
 
 def _active_armature(context):
@@ -25,7 +28,7 @@ class AUTORIG_OT_rename_bones(bpy.types.Operator):
     preset: EnumProperty(
         name="Names",
         description="The bone names to give",
-        items=[(preset, label.split(" (")[0], label) for preset, label in PRESET_LABELS.items()],
+        items=PRESET_ITEMS,
         default=DEFAULT_PRESET,
     )
 
@@ -43,7 +46,7 @@ class AUTORIG_OT_rename_bones(bpy.types.Operator):
         except InputError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        label = PRESET_LABELS[self.preset].split(" (")[0]
+        label = PRESET_TITLES[self.preset]
         if not mapping:
             self.report({"INFO"}, f"'{armature.name}' already has {label} names.")
         else:

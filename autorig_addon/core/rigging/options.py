@@ -43,7 +43,7 @@ RIG_OPTIONS = option_table(
     Option("names", str, name_presets.DEFAULT_PRESET, "Bone Names",
            "How the bones of a standard biped are named: Blender's Rigify, or a game engine's or mocap library's "
            "humanoid names (other skeletons keep Rigify's names)",
-           choices=tuple(Choice(preset, label.split(" (")[0], label) for preset, label in
+           choices=tuple(Choice(preset, name_presets.PRESET_TITLES[preset], label) for preset, label in
                          name_presets.PRESET_LABELS.items())),
 )
 

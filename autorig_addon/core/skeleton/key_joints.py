@@ -334,9 +334,5 @@ def leg_root(joints: np.ndarray, parents: np.ndarray, left_thigh: int, right_thi
         return None
     across /= 2.0 * half
     middle = (joints[left_thigh] + joints[right_thigh]) / 2.0
-    joint = int(parents[left_thigh])
-    while joint >= 0:
-        if abs(float((joints[joint] - middle) @ across)) <= MIDLINE_SHARE * half:
-            return joint
-        joint = int(parents[joint])
-    return None
+    return next((joint for joint in ancestors(parents, left_thigh)
+                 if abs(float((joints[joint] - middle) @ across)) <= MIDLINE_SHARE * half), None)

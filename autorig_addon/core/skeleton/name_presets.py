@@ -76,6 +76,10 @@ PRESET_LABELS = {
 }
 
 
+#: Each preset's short name, as the panel's menus show it.
+PRESET_TITLES = {preset: label.split(" (")[0] for preset, label in PRESET_LABELS.items()}
+
+
 def preset_of(names) -> str | None:
     """The preset whose names the skeleton uses most (at least its hips, an
     upper arm and a thigh), or None."""
