@@ -16,6 +16,7 @@ from autorig_addon.blender.jobs.rig import PREDICTED_PROPERTY, RigSettings, plan
 from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.blender.operators.rig import _RigOperator
 from autorig_addon.core.errors import Cancelled
+from autorig_addon.core.geometry.outward_faces import inward_faces_note
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
 from blender_fixtures import (
@@ -222,6 +223,31 @@ def test_auto_rig_binds_every_vertex(biped):
     # Bound, the armature no longer follows the settings.
     assert rig.live_note(bpy.context)[0] == ("'Biped_rig' is bound to meshes: the settings apply at the next "
                                              "Predict Skeleton")
+
+
+def test_flipped_normals_auto_rig_as_the_mesh_wound_right(biped, capfd):
+    """Faces flipped in Blender (Mesh > Normals > Flip, or a negative scale
+    applied) give the skeleton and the weights of the same mesh unflipped;
+    the report says so and the mesh keeps its faces as they were."""
+    flipped = add_biped("Flipped")
+    flipped.data.flip_normals()
+    flipped_faces = [tuple(polygon.vertices) for polygon in flipped.data.polygons]
+    assert flipped_faces != [tuple(polygon.vertices) for polygon in biped.data.polygons]
+    rigs = {}
+    for obj in (biped, flipped):
+        select_only([obj], active=obj)
+        assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+        skeleton = convert.read_skeleton(bpy.data.objects[f"{obj.name}_rig"])
+        rigs[obj.name] = skeleton, group_weights(obj, skeleton.names)
+
+    (skeleton, weights), (flipped_skeleton, flipped_weights) = rigs["Biped"], rigs["Flipped"]
+    assert flipped_skeleton.names == skeleton.names
+    np.testing.assert_allclose(flipped_skeleton.joints, skeleton.joints, atol=1e-6, rtol=0)
+    np.testing.assert_allclose(flipped_weights, weights, atol=1e-6, rtol=0)
+    report = capfd.readouterr().out
+    for reader in ("the skeleton prediction", "the skinning"):  # every face is a triangle
+        assert report.count(inward_faces_note(len(biped.data.polygons), reader)) == 1
+    assert [tuple(polygon.vertices) for polygon in flipped.data.polygons] == flipped_faces
 
 
 def test_nothing_selected_is_refused_and_scene_unchanged(biped):

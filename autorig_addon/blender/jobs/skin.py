@@ -23,6 +23,7 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.geometry.outliers import require_finite_positions, rows_for_strays
+from ...core.geometry.outward_faces import inward_faces_note, outward_mesh
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback
 from ...core.skeleton.tails import TailDecision, with_reliable_tails
@@ -168,6 +169,10 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         raise InputError("The mesh has zero size.")
     if strays is not None:
         notes += [f"'{name}': {note}" for name, note in stray_notes(mesh, strays, "the distances").items()]
+    # The core turns them itself (``skin_weights``); the report says so.
+    inward = outward_mesh(solved)[1]
+    if inward.any():
+        notes.append(inward_faces_note(int(inward.sum()), "the skinning"))
     # Point-like bones (glTF imports of scaled armatures) get tails derived
     # from the joints; a zero-length deform bone with no child is refused.
     skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)

@@ -1,7 +1,8 @@
 """A skeleton for a bare character mesh, RigNet's way (Xu et al. 2020).
 
 1. :func:`predict_votes` (the slow part, about a second): the mesh's
-   triangles are simplified to a proxy of :data:`.joint_features.PROXY_VERTICES`
+   triangles, wound outward (:mod:`..geometry.outward_faces`), are
+   simplified to a proxy of :data:`.joint_features.PROXY_VERTICES`
    vertices, moved into RigNet's normalised frame (feet at z = 0, largest
    side 1), checked for orientation, and the joint network moves every
    vertex toward its joint and weighs its vote (:mod:`.networks.joints`).
@@ -29,6 +30,7 @@ from ..errors import InputError
 from ..geometry.bounding_box import bounding_box_diagonal
 from ..geometry.normals import triangle_double_areas
 from ..geometry.outliers import without_vertices
+from ..geometry.outward_faces import inward_faces_note, outward_mesh
 from ..geometry.proxy import simplified_proxy
 from ..nn.numpy_kernels import NUMPY, sigmoid
 from ..nn.spec import shipped_weights
@@ -191,12 +193,14 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     surface = Mesh(*without_vertices(mesh.vertices, mesh.triangles, faceless)[1:])
     if not np.all(np.isfinite(surface.vertices)):
         raise InputError("The mesh has vertices at NaN or infinite positions; fix them before predicting a skeleton.")
+    # The proxy's clusters and the networks' normals follow the winding: read it outward whatever the file's.
+    surface, inward = outward_mesh(surface)
     require_enough_faces(surface)
     weights = shipped_weights(joint_network.SPEC).weights
     report(progress, 0.0, "Simplifying the mesh")
     proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
     transform = normalisation_transform(proxy.vertices)
-    notes = []
+    notes = [inward_faces_note(int(inward.sum()), "the skeleton prediction")] if inward.any() else []
     turns = facing_turns(apply_transform(proxy.vertices, transform))
     if turns:
         transform = normalisation_transform(proxy.vertices, turns)

@@ -12,12 +12,15 @@ Some options belong to the geometric method alone
 smoothing): a network ignores them (the panel disables them, the command
 line says so when one was changed: :func:`.options.ignored_options`); the
 resolution of the voxel distances and the influence limit apply to every
-method.
+method. Every method reads the triangles wound outward
+(:mod:`..geometry.outward_faces`): flipped normals give the weights of the
+same mesh wound right.
 """
 
 from __future__ import annotations
 
 from ..errors import InputError
+from ..geometry.outward_faces import outward_mesh
 from ..progress import ProgressCallback
 from ..types import Mesh, Skeleton, Weights
 from .geometric import geometric_weights
@@ -58,7 +61,8 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
 
     Parameters
     ----------
-    mesh : Mesh
+    mesh : Mesh, its triangles read wound outward whatever their winding
+        (:func:`...geometry.outward_faces.outward_mesh`)
     skeleton : Skeleton; only bones with ``deform`` set get weights
     options : SkinningOptions (:mod:`.options`, which imports this module
         for the method names): the method (one of :data:`SKIN_METHODS`), the
@@ -78,6 +82,8 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
     (no deform bones, no vertices, a network's missing weights file).
     """
     check_skin_method(options.method)
+    # Every method's proxy and the networks' normals follow the winding: read it outward whatever the file's.
+    mesh = outward_mesh(mesh)[0]
     if options.method != GEOMETRIC:
         return learned_weights(mesh, skeleton, options.method, max_influences=options.max_influences,
                                resolution=options.resolution, progress=progress)
