@@ -3,8 +3,11 @@
 Vertices, triangles and bone ends go through ``foreach_get`` into numpy;
 deform weights, which have no ``foreach_get``, through one flat pass over
 the vertices' group memberships. Nothing here changes the objects, except
-that the armatures posing a mesh are shown in Rest Position while it is
-read (:func:`.armature_binding.objects_at_rest`) and restored afterwards.
+that while a mesh is read the armatures posing it are shown in Rest
+Position (:func:`.armature_binding.objects_at_rest`) and, for its rest
+shape (:func:`read_rest_shape`), the modifiers after its Armature
+modifier's place are switched off and its vertices numbered
+(:mod:`.modifier_stack`); all come back afterwards.
 
 Writing lives beside this module: :mod:`.weight_writer` (vertex groups and
 the armature binding), :mod:`.status_attribute` (the transfer status
@@ -13,6 +16,7 @@ colours) and :mod:`.snapshot` (undoing a write that fails half-way).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Sequence
 
 import bpy
@@ -23,6 +27,7 @@ from ..core.errors import InputError
 from ..core.skeleton.hierarchy import parents_first_order, reindexed_parents
 from ..core.types import Mesh, Skeleton, Weights
 from .armature_binding import objects_at_rest
+from .modifier_stack import cut_off, numbered_own_vertices, own_vertices_first, stack_cut, vertex_adders
 
 
 def _as_object_list(objects) -> list:
@@ -67,6 +72,31 @@ def _local_vertices(mesh_data) -> np.ndarray:
     return positions.reshape(-1, 3).astype(np.float64)
 
 
+def _world_mesh(obj, source, evaluated_object, later_modifiers: Sequence = ()) -> Mesh:
+    """World-space Mesh of ``source`` (``obj``'s mesh datablock or its evaluated
+    mesh); ``later_modifiers``: the modifiers switched off while it was read,
+    which the message names when it has no faces."""
+    vertices = _local_vertices(source)
+    triangles, polygons = _triangles_of(source)
+    if not len(triangles):
+        if later_modifiers:
+            names = ", ".join(f"'{modifier.name}'" for modifier in later_modifiers)
+            raise InputError(
+                f"'{obj.name}' has no faces before its modifier {names}, where the Armature modifier deforms it: "
+                f"it is only vertices or edges there. Apply {names} first (Ctrl+A)."
+            )
+        raise InputError(
+            f"'{obj.name}' has no faces: it is only vertices or edges. "
+            "Add faces to it (Edit Mode > Face > Fill) or pick a mesh with a surface."
+        )
+    # The evaluated object's matrix is current even before the original's is synced.
+    matrix = _matrix_to_numpy((evaluated_object if evaluated_object is not None else obj).matrix_world)
+    if np.linalg.det(matrix[:3, :3]) < 0:
+        # A mirroring transform turns counter-clockwise triangles clockwise.
+        triangles = triangles[:, ::-1].copy()
+    return Mesh(_transform_points(vertices, matrix), triangles, polygons, None, (obj.name,))
+
+
 def _read_one_mesh(obj, depsgraph) -> Mesh:
     require_mesh_object(obj, "mesh")
     original = obj.data
@@ -78,23 +108,10 @@ def _read_one_mesh(obj, depsgraph) -> Mesh:
         # Modifiers that add or remove vertices break the 1:1 mapping back to
         # the original vertex groups, so such meshes are read undeformed.
         use_evaluated = evaluated_mesh is not None and len(evaluated_mesh.vertices) == len(original.vertices)
-        source = evaluated_mesh if use_evaluated else original
-        vertices = _local_vertices(source)
-        triangles, polygons = _triangles_of(source)
+        return _world_mesh(obj, evaluated_mesh if use_evaluated else original, evaluated_object)
     finally:
         if evaluated_mesh is not None:
             evaluated_object.to_mesh_clear()
-    if not len(triangles):
-        raise InputError(
-            f"'{obj.name}' has no faces: it is only vertices or edges. "
-            "Add faces to it (Edit Mode > Face > Fill) or pick a mesh with a surface."
-        )
-    # The evaluated object's matrix is current even before the original's is synced.
-    matrix = _matrix_to_numpy((evaluated_object if evaluated_object is not None else obj).matrix_world)
-    if np.linalg.det(matrix[:3, :3]) < 0:
-        # A mirroring transform turns counter-clockwise triangles clockwise.
-        triangles = triangles[:, ::-1].copy()
-    return Mesh(_transform_points(vertices, matrix), triangles, polygons, None, (obj.name,))
 
 
 def read_mesh(objects, depsgraph=None) -> Mesh:
@@ -127,6 +144,120 @@ def read_mesh(objects, depsgraph=None) -> Mesh:
         if depsgraph is None:
             depsgraph = bpy.context.evaluated_depsgraph_get()
         return Mesh.concatenate([_read_one_mesh(obj, depsgraph) for obj in object_list])
+
+
+@dataclass(frozen=True)
+class RestShape:
+    """The shape each mesh's Armature modifier deforms (:mod:`.modifier_stack`),
+    world space, as read by :func:`read_rest_shape`.
+
+    Attributes
+    ----------
+    mesh : Mesh, every object's evaluated vertices: in object ``k``'s slice
+        its own ``own_counts[k]`` vertices first, in Blender's order, then
+        those a Mirror modifier added
+    own_counts : tuple of int, each object's own vertex count
+    places : tuple of int, the stack index each object was read at (its Armature modifier's place)
+    """
+
+    mesh: Mesh
+    own_counts: tuple
+    places: tuple
+
+    def own_rows(self, index: int) -> slice:
+        """Rows of ``mesh`` holding object ``index``'s own vertices."""
+        start = int(self.mesh.object_offsets[index])
+        return slice(start, start + self.own_counts[index])
+
+    def added_count(self, index: int) -> int:
+        """How many vertices object ``index``'s modifiers added (a Mirror's copies)."""
+        rows = self.mesh.object_slice(index)
+        return rows.stop - rows.start - self.own_counts[index]
+
+
+def read_rest_shape(objects, places: Sequence[int], depsgraph=None) -> RestShape:
+    """World-space shape of mesh objects as their Armature modifier deforms
+    it: evaluated with every modifier from ``places[k]`` on switched off and
+    the armatures posing them at rest (:func:`.modifier_stack.stack_cut`).
+
+    Unlike :func:`read_mesh`, vertices a Mirror modifier adds before the
+    place are kept, after the object's own (checked:
+    :func:`.modifier_stack.own_vertices_first`).
+
+    Raises
+    ------
+    InputError for non-mesh objects, a shape without faces, or modifiers
+    before the place whose vertices cannot be traced back to the mesh's own.
+    """
+    object_list = _as_object_list(objects)
+    if not object_list:
+        raise InputError("No mesh objects given.")
+    for obj in object_list:
+        require_mesh_object(obj, "mesh")
+    places = tuple(int(place) for place in places)
+    numbered = [obj.data for obj, place in zip(object_list, places) if vertex_adders(obj, place)]
+    later = [cut_off(obj, place) for obj, place in zip(object_list, places)]  # before they are switched off
+    with objects_at_rest(object_list), stack_cut(dict(zip(object_list, places))), numbered_own_vertices(numbered):
+        if depsgraph is None:
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        meshes = [_read_rest_mesh(obj, place, depsgraph, obj.data in numbered, cut)
+                  for obj, place, cut in zip(object_list, places, later)]
+    return RestShape(Mesh.concatenate(meshes), tuple(len(obj.data.vertices) for obj in object_list), places)
+
+
+def _read_rest_mesh(obj, place: int, depsgraph, numbered: bool, later: list) -> Mesh:
+    """One object of :func:`read_rest_shape`, its modifiers from ``place`` on
+    (``later``) switched off; ``numbered``: its vertices carry their numbers."""
+    own_count = len(obj.data.vertices)
+    evaluated_object = obj.evaluated_get(depsgraph)
+    evaluated_mesh = evaluated_object.to_mesh()
+    try:
+        count = len(evaluated_mesh.vertices)
+        traced = own_vertices_first(evaluated_mesh, own_count) if numbered else count == own_count
+        if not traced:
+            before = vertex_adders(obj, place) or list(obj.modifiers)[:place]
+            names = ", ".join(f"'{modifier.name}'" for modifier in before)
+            raise InputError(
+                f"'{obj.name}': the modifier {names} before the Armature modifier's place changes the mesh's own "
+                f"vertices (a Mirror's Bisect cuts them), so weights could not be written back to them: apply {names} "
+                "first (Ctrl+A)."
+            )
+        return _world_mesh(obj, evaluated_mesh, evaluated_object, later)
+    finally:
+        evaluated_object.to_mesh_clear()
+
+
+def evaluated_bounds(obj, depsgraph=None) -> tuple[np.ndarray, np.ndarray] | None:
+    """World-space bounding box ``(low, high)`` of ``obj`` as the viewport
+    shows it with every modifier and its armatures at rest; None when the
+    evaluated mesh has no vertices."""
+    with objects_at_rest([obj]):
+        if depsgraph is None:
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        evaluated_object = obj.evaluated_get(depsgraph)
+        evaluated_mesh = evaluated_object.to_mesh()
+        try:
+            if not len(evaluated_mesh.vertices):
+                return None
+            points = _transform_points(_local_vertices(evaluated_mesh), _matrix_to_numpy(evaluated_object.matrix_world))
+        finally:
+            evaluated_object.to_mesh_clear()
+    return points.min(axis=0), points.max(axis=0)
+
+
+def read_rest_group_weights(obj, place: int, group_names: Sequence[str], depsgraph=None) -> np.ndarray:
+    """(m, k) float64 deform weights of the named groups on every vertex the
+    Armature modifier at ``place`` receives (a Mirror's copies included, with
+    the groups it gave them): what posing will use. Zero column when missing."""
+    with stack_cut({obj: place}):
+        if depsgraph is None:
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        evaluated_object = obj.evaluated_get(depsgraph)
+        evaluated_mesh = evaluated_object.to_mesh()
+        try:
+            return _group_weights_of(evaluated_mesh, obj.vertex_groups, group_names)
+        finally:
+            evaluated_object.to_mesh_clear()
 
 
 def require_armature_object(obj) -> None:
@@ -180,20 +311,26 @@ def deform_bone_names(armature_obj) -> tuple[str, ...]:
 
 def read_group_weights(obj, group_names: Sequence[str]) -> np.ndarray:
     """(n, k) float64 weights of the named vertex groups (zero column when missing)."""
+    return _group_weights_of(obj.data, obj.vertex_groups, group_names)
+
+
+def _group_weights_of(mesh_data, vertex_groups, group_names: Sequence[str]) -> np.ndarray:
+    """(n, k) weights of the named groups (``vertex_groups``: the object's
+    list, which numbers them) on the vertices of ``mesh_data``."""
     names = list(group_names)
-    column_of_group = np.full(max(len(obj.vertex_groups), 1), -1, dtype=np.int64)
+    column_of_group = np.full(max(len(vertex_groups), 1), -1, dtype=np.int64)
     for column, name in enumerate(names):
-        group = obj.vertex_groups.get(name)
+        group = vertex_groups.get(name)
         if group is not None:
             column_of_group[group.index] = column
-    vertex_count = len(obj.data.vertices)
+    vertex_count = len(mesh_data.vertices)
     matrix = np.zeros((vertex_count, len(names)), dtype=np.float64)
     if not np.any(column_of_group >= 0):
         return matrix
     # No foreach_get exists for deform weights; one flat comprehension over
     # the elements is the fastest route found (about 0.12 s for 50k vertices
     # with three groups each, half the time of a nested loop).
-    memberships = [vertex.groups for vertex in obj.data.vertices]
+    memberships = [vertex.groups for vertex in mesh_data.vertices]
     counts = np.fromiter(map(len, memberships), dtype=np.int64, count=vertex_count)
     elements = [(element.group, element.weight) for groups in memberships for element in groups]
     if not elements:

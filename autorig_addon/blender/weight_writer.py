@@ -32,6 +32,7 @@ import numpy as np
 from ..core.errors import InputError
 from ..core.types import Weights
 from .convert import deform_bone_names, read_group_weights, require_armature_object, require_mesh_object
+from .modifier_stack import armature_place, kept_armature_modifier
 
 #: Name given to the Armature modifier this add-on creates.
 ARMATURE_MODIFIER_NAME = "Armature"
@@ -140,10 +141,13 @@ def ensure_armature_binding(obj, armature_obj, world=None) -> None:
     *Armature* parent type: either would move it a second time), keeping
     its world transform.
 
-    An existing Armature modifier is reused (one on this armature first,
-    then an empty one, then one on another armature, which is retargeted);
-    every other Armature modifier is removed, or the mesh would be deformed
-    twice. :class:`~.snapshot.ObjectSnapshot` can rebuild them.
+    An existing Armature modifier is reused where it is
+    (:func:`~.modifier_stack.kept_armature_modifier`: one on this armature
+    first, then an empty one, then one on another armature, which is
+    retargeted); every other Armature modifier is removed, or the mesh would
+    be deformed twice. :class:`~.snapshot.ObjectSnapshot` can rebuild them.
+    A new one goes where posing deforms the rest shape the user sees
+    (:func:`~.modifier_stack.armature_place`).
 
     Parameters
     ----------
@@ -154,18 +158,17 @@ def ensure_armature_binding(obj, armature_obj, world=None) -> None:
         one). A prop carried by a bone of a posed armature passes its rest
         one (:class:`~.object_roles.RigidBinding`).
     """
-    armature_modifiers = [m for m in obj.modifiers if m.type == "ARMATURE"]
-    ranked = sorted(armature_modifiers, key=lambda m: (m.object != armature_obj, m.object is not None))
-    if ranked:
-        keep = ranked[0]
-        keep.object = armature_obj
-        for modifier in ranked[1:]:
+    keep = kept_armature_modifier(obj, armature_obj)
+    if keep is not None:
+        for modifier in [m for m in obj.modifiers if m.type == "ARMATURE" and m != keep]:
             obj.modifiers.remove(modifier)
     else:
+        place = armature_place(obj)
         keep = obj.modifiers.new(ARMATURE_MODIFIER_NAME, "ARMATURE")
-        keep.object = armature_obj
-        # Deform before anything else (subdivision, solidify) as Ctrl+P does.
-        obj.modifiers.move(len(obj.modifiers) - 1, 0)
+        # After the modifiers that shape the rest pose (a Mirror, a Simple
+        # Deform), before those that finish the surface (subdivision, solidify).
+        obj.modifiers.move(len(obj.modifiers) - 1, place)
+    keep.object = armature_obj
     keep.use_vertex_groups = True
     if obj.parent != armature_obj or obj.parent_type != "OBJECT":
         world = (obj.matrix_world if world is None else world).copy()
@@ -183,7 +186,7 @@ def _writable_columns(weights: Weights, armature_obj) -> list[int]:
 
 
 def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = False, keep_groups: Sequence[str] = (),
-                  world=None) -> None:
+                  world=None, every_bone: bool = False) -> None:
     """Store ``weights`` in ``obj``'s vertex groups and bind it to the armature
     (:func:`ensure_armature_binding`).
 
@@ -201,6 +204,10 @@ def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = Fa
     keep_groups : sequence of str
         Groups ``replace_all`` leaves alone (the artist's mask groups).
     world : mathutils.Matrix or None, passed to :func:`ensure_armature_binding`
+    every_bone : bool
+        Give every written deform bone a group, an empty one where it has no
+        weight (a Mirror modifier gives its copies the mirrored bone's
+        group only when that group exists).
 
     Raises
     ------
@@ -226,7 +233,7 @@ def write_weights(obj, weights: Weights, armature_obj, *, replace_all: bool = Fa
     for column in columns:
         name = weights.bone_names[column]
         # A bone with no weight anywhere gets no new group, and an existing one is emptied.
-        if used[column] or obj.vertex_groups.get(name) is not None:
+        if every_bone or used[column] or obj.vertex_groups.get(name) is not None:
             values[name] = weights.matrix[:, column]
     fill_groups(obj, values)
     ensure_armature_binding(obj, armature_obj, world)

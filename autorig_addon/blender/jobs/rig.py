@@ -34,6 +34,7 @@ import bpy
 import numpy as np
 
 from ...core.errors import InputError
+from ...core.geometry.flatness import flatness
 from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
@@ -54,6 +55,14 @@ from ...core.types import Mesh, Skeleton
 from .. import convert
 from ..armature_binding import armature_bindings, bound_armature, deforms, followers, remove_armature, unbind
 from ..armature_builder import build_armature
+from ..modifier_stack import (
+    DEFORM_ONLY_TYPES,
+    SHAPELESS_TYPES,
+    SURFACE_FINISH_TYPES,
+    armature_place,
+    binding_place,
+    cut_off,
+)
 from ..rigify_rig import generate_rigify_rig
 from ..snapshot import restored_on_failure
 from .input_checks import check_mode
@@ -73,6 +82,13 @@ PREDICTION_SHARE = 0.4
 #: Rest bone positions differing by more than this share of the skeleton's
 #: extent mean the armature was edited (Blender stores bones in float32).
 EDIT_TOLERANCE = 1e-5
+#: A side of the bounding box the user sees lying farther than this share of
+#: its diagonal from the shape the Armature modifier deforms means the
+#: modifiers after it change the character: the skeleton would not fit it.
+MAX_UNRIGGED_CHANGE = 0.1
+#: An object scale whose largest axis is this many times its smallest is named
+#: when the shape is flat (an unapplied scale squashing the character).
+UNEVEN_SCALE_RATIO = 1.5
 
 
 @dataclass(frozen=True)
@@ -107,7 +123,9 @@ class RigPlan:
     Attributes
     ----------
     meshes : list of bpy.types.Object, the character's meshes
-    mesh : Mesh, their world-space rest shape, concatenated
+    mesh : Mesh, their world-space rest shape, concatenated: each as its
+        Armature modifier will deform it (``convert.read_rest_shape``), a
+        Mirror modifier's mirrored half included
     name : str, the name of the armature to build
     settings : RigSettings
     skin : SkinSettings or None, bind the meshes with these (Auto-Rig) or not
@@ -193,11 +211,68 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
                 f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
                 "it to the new skeleton instead, or remove its Armature modifier first."
             )
-    mesh = convert.read_mesh(meshes, depsgraph)
+    # The old Armature modifiers go with Replace Binding, and Predict Skeleton binds nothing: the new one's place.
+    places = [armature_place(obj) if skin is None or replace else binding_place(obj) for obj in meshes]
+    rest = convert.read_rest_shape(meshes, places, depsgraph)
+    mesh = rest.mesh
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
+    _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
+    _require_not_flat(meshes, mesh)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
     return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor)
+
+
+def _require_rigged_shape_is_seen(meshes, places, rest: convert.RestShape, depsgraph) -> None:
+    """Refuse meshes whose modifiers after the Armature modifier's place
+    change the shape the user sees a lot (an Array, a Boolean, a Simple
+    Deform below a Subdivision Surface): the skeleton would be fitted to the
+    shape before them. Modifiers that only refine the surface are left out
+    of the comparison (``modifier_stack.SURFACE_FINISH_TYPES``)."""
+    for index, (obj, place) in enumerate(zip(meshes, places)):
+        later = cut_off(obj, place)
+        changing = [modifier for modifier in later if modifier.type not in SURFACE_FINISH_TYPES | SHAPELESS_TYPES]
+        if not changing:
+            continue
+        seen = convert.evaluated_bounds(obj, depsgraph)
+        rigged = rest.mesh.vertices[rest.mesh.object_slice(index)]
+        if seen is not None:
+            low, high = seen
+            size = max(float(np.linalg.norm(high - low)), 1e-12)
+            change = max(np.abs(rigged.min(axis=0) - low).max(), np.abs(rigged.max(axis=0) - high).max()) / size
+            if change <= MAX_UNRIGGED_CHANGE:
+                continue
+        names = listed_names([modifier.name for modifier in changing], quoted=True)
+        fix = f"apply {names} first (Ctrl+A)"
+        if all(modifier.type in DEFORM_ONLY_TYPES | {"MIRROR"} for modifier in changing):
+            fix = f"move {names} above '{later[0].name}' in the modifier stack, or {fix}"
+        raise InputError(
+            f"'{obj.name}': its modifier {names} changes the shape a lot after the place where the Armature modifier "
+            f"deforms it (before '{later[0].name}'), so the skeleton would be fitted to another shape than the one "
+            f"shown: {fix}."
+        )
+
+
+def _require_not_flat(meshes, mesh: Mesh) -> None:
+    """Refuse a flat shape (``core.geometry.flatness``): not a body a
+    skeleton can be predicted for; name an uneven object scale that may
+    have squashed it."""
+    shape = flatness(mesh.vertices, mesh.triangles)
+    if not shape.is_flat:
+        return
+    names = listed_names([obj.name for obj in meshes], quoted=True)
+    what = f"{names} is" if len(meshes) == 1 else f"Together, {names} are"
+    message = (f"{what} flat: {shape.thickness:.3g} thick and {shape.width:.3g} by {shape.length:.3g} across "
+               f"(its thickness is {shape.thickness_ratio:.0%} of its width): a skeleton is predicted for a body with "
+               "some depth.")
+    for obj in meshes:
+        scale = np.abs(np.array(obj.matrix_world.to_scale()))
+        if scale.max() > UNEVEN_SCALE_RATIO * max(scale.min(), 1e-12):
+            shown = ", ".join(f"{value:.3g}" for value in obj.scale)
+            message += (f" '{obj.name}' has the object scale ({shown}), which squashes it: give it the scale the "
+                        "character should have (Object properties > Transform), then rig it.")
+            break
+    raise InputError(message + " Nothing was built.")
 
 
 def _remember(armature, votes: JointVotes) -> None:

@@ -13,10 +13,15 @@ As with transfer, nothing is written before everything is computed:
 What the plan does with props parented to a bone, helper objects, linked
 duplicates and stray vertices: :mod:`..object_roles` and
 :mod:`autorig_addon.core.geometry.outliers`; each is named in the report.
+The weights are computed on the shape the Armature modifier deforms, a
+Mirror modifier's mirrored half included (:mod:`..modifier_stack`), and
+the artist's own groups that share a bone's name are kept under a new name
+(:mod:`..artist_groups`).
 """
 
 from __future__ import annotations
 
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,6 +36,8 @@ from ...core.skinning.methods import SKIN_METHOD_LABELS, check_skin_method, skin
 from ...core.skinning.options import SkinningOptions
 from ...core.types import Mesh, Skeleton, Weights
 from .. import convert
+from ..artist_groups import artist_group_renames, renamed_artist_groups, renames_note
+from ..modifier_stack import REST_SHAPE_TYPES, binding_place, kept_armature_modifier, vertex_adders
 from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
 from ..snapshot import restored_on_failure
 from ..weight_writer import bind_to_bone, write_weights
@@ -41,6 +48,15 @@ from .worker_job import WorkerJob
 #: farther than this many mesh diagonals from it, the armature was not
 #: placed on the character.
 MAX_ARMATURE_OFFSET = 0.5
+#: The vertices a Mirror modifier (or another before the Armature
+#: modifier) adds follow the wrong bones when, for a
+#: bone, the weight they get from the modifier's groups and the weight
+#: computed for them differ by more than this share of the larger (a left
+#: bone the modifier does not swap for its right twin: about 1; a symmetric
+#: skin: up to 0.3 measured, the networks' weights being nearly symmetric) ...
+MAX_ADDED_BONE_MISMATCH = 0.6
+#: ... counting only bones whose weight there sums to more than this share of those vertices.
+MIN_ADDED_BONE_SHARE = 0.01
 
 
 @dataclass(frozen=True)
@@ -76,7 +92,9 @@ class SkinPlan:
     ----------
     armature : bpy.types.Object
     meshes : list of bpy.types.Object, the meshes skinned together
-    mesh : Mesh of ``meshes`` (None when there are none)
+    mesh : Mesh of ``meshes`` (None when there are none): the shape their
+        Armature modifiers deform, the vertices a Mirror modifier adds after
+        each object's own (``rest``)
     skeleton : Skeleton
     settings : SkinSettings
     tail_decision : TailDecision
@@ -85,7 +103,10 @@ class SkinPlan:
         (``core.geometry.outliers``), or None
     solved : Mesh the weights are computed on: ``mesh`` without ``strays``
     rigid : list of RigidBinding, props bound wholly to the bone they were parented to
-    notes : list of str, what the report adds about them, linked duplicates and props left rigid
+    notes : list of str, what the report adds about them, linked duplicates, props left rigid,
+        the Armature modifier's place and the artist's groups kept
+    rest : convert.RestShape or None, how ``mesh``'s rows map to each object's own vertices
+    renames : list of dict, per mesh the artist's groups to keep under a new name (``artist_groups``)
     """
 
     armature: object
@@ -98,6 +119,8 @@ class SkinPlan:
     solved: Mesh | None = None
     rigid: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+    rest: convert.RestShape | None = None
+    renames: list = field(default_factory=list)
 
     @property
     def summary(self) -> str:
@@ -162,8 +185,14 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     notes += [f"'{obj.name}' {note}" for obj, note in shared_mesh_notes(meshes + [b.obj for b in rigid]).items()]
     if not meshes:
         return SkinPlan(armature, [], None, skeleton, settings, rigid=rigid, notes=notes)
-    mesh = convert.read_mesh(meshes, depsgraph)
+    places = [binding_place(obj, armature) for obj in meshes]
+    rest = convert.read_rest_shape(meshes, places, depsgraph)
+    mesh = rest.mesh
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
+    notes += [note for obj, place in zip(meshes, places) if (note := _placement_note(obj, armature, place))]
+    written = [name for name, deform in zip(skeleton.names, skeleton.deform) if deform]
+    renames = [{} if settings.replace_all else artist_group_renames(obj, written, armature) for obj in meshes]
+    notes += [renames_note(obj.name, renamed) for obj, renamed in zip(meshes, renames) if renamed]
     solved, strays = split_strays(mesh)
     if solved.bounding_box_diagonal <= 0:
         raise InputError("The mesh has zero size.")
@@ -177,7 +206,20 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     # from the joints; a zero-length deform bone with no child is refused.
     skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)
     _check_skeleton_fits_mesh(skeleton.deform_subset(), solved, armature.name)
-    return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes)
+    return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes,
+                    rest, renames)
+
+
+def _placement_note(obj, armature, place: int) -> str:
+    """What the report says when a new Armature modifier goes after modifiers
+    that shape the rest pose ("" when the mesh keeps its own or none come before)."""
+    if kept_armature_modifier(obj, armature) is not None:
+        return ""
+    before = [modifier.name for modifier in list(obj.modifiers)[:place] if modifier.type in REST_SHAPE_TYPES]
+    if not before:
+        return ""
+    return (f"'{obj.name}': the Armature modifier goes after {listed_names(before, quoted=True)}, so posing deforms "
+            "the shape the weights were computed on")
 
 
 def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> Weights:
@@ -195,18 +237,61 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
 
 
 def write_skin(plan: SkinPlan, weights: Weights) -> None:
-    """Write each mesh's rows and bind the props on a bone to it; on any
+    """Write each mesh's own rows, keeping the artist's groups that share a
+    bone's name under a new name, and bind the props on a bone to it; on any
     failure every object is restored. Linked duplicates get their own mesh
-    first."""
-    with restored_on_failure(plan.meshes + [binding.obj for binding in plan.rigid]):
+    first. A mesh whose modifiers before the Armature modifier add vertices
+    (a Mirror) is checked once written: the groups they give the added
+    vertices must hold the weights computed for them
+    (:func:`_check_added_vertices`)."""
+    with restored_on_failure(plan.meshes + [binding.obj for binding in plan.rigid]), ExitStack() as renamed:
         for index, obj in enumerate(plan.meshes):
             give_own_mesh(obj)
-            rows = plan.mesh.object_slice(index)
-            write_weights(obj, Weights(weights.matrix[rows], weights.bone_names), plan.armature,
-                          replace_all=plan.settings.replace_all)
+            renamed.enter_context(renamed_artist_groups(obj, plan.renames[index]))
+            added = plan.rest.added_count(index)
+            # A Mirror modifier gives a copy the mirrored bone's group only when that group exists.
+            write_weights(obj, Weights(weights.matrix[plan.rest.own_rows(index)], weights.bone_names), plan.armature,
+                          replace_all=plan.settings.replace_all, every_bone=added > 0)
+            if added:
+                computed = weights.matrix[plan.mesh.object_slice(index)]
+                _check_added_vertices(obj, plan.armature, computed, weights.bone_names, plan.rest.own_counts[index])
         for binding in plan.rigid:
             give_own_mesh(binding.obj)
             bind_to_bone(binding.obj, binding.armature, binding.bone, binding.rest_world)
+
+
+def _check_added_vertices(obj, armature, computed: np.ndarray, bone_names, own_count: int) -> None:
+    """Refuse (:class:`InputError`) a mesh whose Armature modifier would
+    give the vertices the modifiers before it add (a Mirror's copies) other
+    bones than ``computed`` (all of its rows, own first), bone by bone: read
+    back what the modifier receives, the groups those modifiers gave them."""
+    place = list(obj.modifiers).index(kept_armature_modifier(obj, armature))
+    received = convert.read_rest_group_weights(obj, place, bone_names)[own_count:]
+    if len(received) + own_count != len(computed):
+        raise InputError(f"'{obj.name}' changed while it was being weighted: run the skinning again.")
+    totals = received.sum(axis=1, keepdims=True)
+    received = np.divide(received, totals, out=np.zeros_like(received), where=totals > 0)
+    received_sums, computed_sums = received.sum(axis=0), computed[own_count:].sum(axis=0)
+    larger = np.maximum(received_sums, computed_sums)
+    wrong = (larger > MIN_ADDED_BONE_SHARE * len(received)) \
+        & (np.abs(received_sums - computed_sums) > MAX_ADDED_BONE_MISMATCH * larger)
+    if not wrong.any():
+        return
+    adders = vertex_adders(obj, place)
+    names = listed_names([modifier.name for modifier in adders], quoted=True)
+    bones = listed_names([name for name, off in zip(bone_names, wrong) if off], quoted=True)
+    mirrors = [modifier for modifier in adders if modifier.type == "MIRROR"]
+    if not all(modifier.use_mirror_vertex_groups for modifier in mirrors):
+        fix = f"turn on the Vertex Groups option of {names} (under Data), or apply it first (Ctrl+A)"
+    elif mirrors:
+        fix = (f"{names} swaps only the vertex groups whose names end in .L/.R or say left/right: apply it first "
+               "(Ctrl+A)")
+    else:
+        fix = f"move the Armature modifier above {names}, or apply {names} first (Ctrl+A)"
+    raise InputError(
+        f"'{obj.name}': the vertices its modifier {names} adds would follow the wrong bones (their weights "
+        f"for {bones} differ from those computed for them): {fix}."
+    )
 
 
 @dataclass
