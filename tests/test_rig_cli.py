@@ -183,11 +183,14 @@ def test_rigify_with_the_free_form_template_is_refused(clean_scene, tmp_path, ca
 
 
 def save_two_far_parts(path):
-    """A post and a block three heights away from it, saved as one character."""
+    """A post and a small block three heights away from it, saved as one
+    character (the block is too small to be refused as a second character:
+    9 % of the area, 0.15 of the post's height)."""
     from geometry_fixtures import box_mesh
 
     reset_scene()
-    post, block = box_mesh([-0.1, -0.1, 0.0], [0.1, 0.1, 1.0], 0.05), box_mesh([3.0, -0.1, 0.0], [3.2, 0.1, 0.3], 0.05)
+    post, block = box_mesh([-0.1, -0.1, 0.0], [0.1, 0.1, 1.0], 0.05), box_mesh([3.0, -0.05, 0.0], [3.1, 0.05, 0.15],
+                                                                              0.05)
     vertices = np.vstack([post.vertices, block.vertices])
     mesh_object("Parts", vertices, np.vstack([post.triangles, block.triangles + len(post.vertices)]))
     bpy.context.view_layer.update()

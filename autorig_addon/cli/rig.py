@@ -1,8 +1,10 @@
 """``python -m autorig_addon rig``: predict a skeleton for the meshes of a
 file and (unless ``--skin none``) bind them to it with skin weights.
 
-Each input holds one character: every mesh of the file except helpers
-(bone shapes, objects hidden from render). A file that already holds an
+Each input holds one character: the meshes named with ``--mesh``, else
+every mesh of the file except helpers (bone shapes, objects hidden from
+render). A file holding several characters apart is refused, naming them:
+rig each with ``--mesh``. A file that already holds an
 armature is refused unless ``--replace``, which removes the armatures, the
 meshes' Armature modifiers and the vertex groups named after their bones
 first. The options are made from the rig option table
@@ -30,6 +32,9 @@ NO_SKIN = "none"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_batch_arguments(parser)
+    parser.add_argument("--mesh", action="append", default=[], metavar="OBJ",
+                        help="Mesh of the character to rig (repeat, or comma-separate; default: every mesh except bone "
+                             "shapes): one character of a file holding several")
     add_options(parser, RIG_OPTIONS)
     parser.add_argument(
         "--skin", choices=SKIN_METHODS + (NO_SKIN,), default=DEFAULT_SKIN_METHOD,
@@ -89,16 +94,19 @@ def run(args: argparse.Namespace) -> int:
 
         from ..blender import scene_io
         from ..blender.object_roles import without_helpers
-        from ..blender.selection import file_meshes
+        from ..blender.selection import file_meshes, find_object, names_in
 
         scene_io.load_scene(input_path)
+        named = names_in(args.mesh)
         # Helpers (bone shapes) are told apart while their armature is still there.
-        meshes = without_helpers(file_meshes())
+        meshes = [find_object(name, "MESH") for name in named] if named else without_helpers(file_meshes())
         removed = clear_armatures(args.replace)
         if not meshes:
             raise InputError("The file holds no mesh to rig.")
-        plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), Path(input_path).stem, settings,
-                        skin=skin, named=False, rigify=args.rigify, keep_poor=args.keep_poor)
+        # Named meshes are one character of the file: the armature takes the first one's name.
+        character = meshes[0].name if named else Path(input_path).stem
+        plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), character, settings,
+                        skin=skin, named=bool(named), rigify=args.rigify, keep_poor=args.keep_poor)
         result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)

@@ -71,6 +71,26 @@ class Mesh:
     def object_slice(self, index: int) -> slice:
         return slice(int(self.object_offsets[index]), int(self.object_offsets[index + 1]))
 
+    def subset(self, keep: np.ndarray) -> "Mesh":
+        """The mesh of the ``keep`` vertices, in order, and the triangles
+        whose corners are all kept; each object keeps its kept vertices
+        (an object left with none is dropped).
+
+        Parameters
+        ----------
+        keep : (n,) bool array
+        """
+        keep = np.asarray(keep, dtype=bool).reshape(-1)
+        new_index = np.full(len(keep), -1, dtype=np.int64)
+        new_index[keep] = np.arange(np.count_nonzero(keep))
+        whole = keep[self.triangles].all(axis=1) if len(self.triangles) else np.zeros(0, dtype=bool)
+        counts = np.array([np.count_nonzero(keep[self.object_slice(i)]) for i in range(len(self.object_names))],
+                          dtype=np.int64)
+        present = counts > 0
+        return Mesh(self.vertices[keep], new_index[self.triangles[whole]], self.triangle_polygons[whole],
+                    np.concatenate([[0], np.cumsum(counts[present])]),
+                    tuple(name for name, kept in zip(self.object_names, present) if kept))
+
     @staticmethod
     def concatenate(meshes: Sequence["Mesh"]) -> "Mesh":
         """One mesh holding ``meshes`` one after another (vertex indices shifted)."""

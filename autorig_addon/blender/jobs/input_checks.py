@@ -65,14 +65,20 @@ def stray_notes(mesh: Mesh, strays: np.ndarray, action: str, *, reweighted: bool
     return notes
 
 
-def split_strays(mesh: Mesh) -> tuple[Mesh, np.ndarray | None]:
+def split_strays(mesh: Mesh, left_out: np.ndarray | None = None) -> tuple[Mesh, np.ndarray | None]:
     """``mesh`` without its far stray vertices (and their triangles), and the
-    stray mask, or ``mesh`` and None when it has none; vertices must be finite."""
-    strays = stray_vertices(mesh.vertices)
-    if not strays.any():
+    stray mask, or ``mesh`` and None when it has none; vertices must be finite.
+    ``left_out``: (n,) bool, vertices also taken out, among which no stray is
+    looked for (they do not count toward the bulk either), or None."""
+    if left_out is None or not left_out.any():
+        strays = stray_vertices(mesh.vertices)
+        drop = strays
+    else:
+        strays = np.zeros(mesh.vertex_count, dtype=bool)
+        strays[~left_out] = stray_vertices(mesh.vertices[~left_out])
+        drop = strays | left_out
+    if not drop.any():
         return mesh, None
-    _, vertices, triangles = without_vertices(mesh.vertices, mesh.triangles, strays)
+    _, vertices, triangles = without_vertices(mesh.vertices, mesh.triangles, drop)
     # The offsets of several objects no longer hold: one object, named after all of them.
-    return Mesh(vertices, triangles, object_names=(", ".join(mesh.object_names),)), strays
-
-
+    return Mesh(vertices, triangles, object_names=(", ".join(mesh.object_names),)), strays if strays.any() else None

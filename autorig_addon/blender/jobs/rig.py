@@ -38,6 +38,7 @@ from ...core.geometry.flatness import flatness
 from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
+from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
 from ...core.rigging.predict import (
     DEFAULT_TEMPLATE,
     JointVotes,
@@ -122,7 +123,7 @@ class RigPlan:
 
     Attributes
     ----------
-    meshes : list of bpy.types.Object, the character's meshes
+    meshes : list of bpy.types.Object, the character's meshes (those wholly left out dropped)
     mesh : Mesh, their world-space rest shape, concatenated: each as its
         Armature modifier will deform it (``convert.read_rest_shape``), a
         Mirror modifier's mirrored half included
@@ -134,6 +135,10 @@ class RigPlan:
     named : bool, the user picked the meshes (False: every mesh of a file; see ``plan_skin``)
     rigify : bool, turn the standard skeleton into Rigify's control rig and bind the meshes to its DEF- bones
     keep_poor : bool, build a skeleton the checks find poor (``core.rigging.quality``) instead of refusing it
+    left_out : (n,) bool array over ``mesh``'s vertices or None: pieces that are not the character
+        (a ground plane, stray specks: ``core.rigging.character_parts``), left out of the prediction and
+        left unweighted
+    notes : tuple of str, what the report says about what was left out
     """
 
     meshes: list
@@ -145,6 +150,13 @@ class RigPlan:
     named: bool = True
     rigify: bool = False
     keep_poor: bool = False
+    left_out: np.ndarray | None = None
+    notes: tuple = ()
+
+    @property
+    def character(self) -> Mesh:
+        """The shape the skeleton is predicted for: ``mesh`` without the ``left_out`` vertices."""
+        return self.mesh if self.left_out is None else self.mesh.subset(~self.left_out)
 
 
 @dataclass
@@ -186,11 +198,17 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
              rigify: bool = False, keep_poor: bool = False) -> RigPlan:
     """Read and check the character's meshes; raises :class:`InputError` on bad input.
 
+    What is not the character (``core.rigging.character_parts``) is told
+    apart here: a ground plane and stray specks are left out (a mesh wholly
+    left out is dropped from the plan, so it is not bound; the plan's notes
+    say so), and meshes holding several characters are refused, naming them.
+
     Parameters
     ----------
     meshes : list of bpy.types.Object, one character
     depsgraph : bpy.types.Depsgraph (the meshes are read evaluated, armatures at rest)
-    name : str, the character's name (the armature is called ``name + ARMATURE_SUFFIX``)
+    name : str, the character's name (the armature is called ``name + ARMATURE_SUFFIX``); a
+        mesh left out gives its name to the first mesh kept instead
     settings : RigSettings
     skin : SkinSettings or None; given, the meshes are bound, and a mesh
         already bound to an armature is refused unless ``replace``
@@ -203,6 +221,16 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     for obj in meshes:
         convert.require_mesh_object(obj, "mesh to rig")
         check_mode(obj, "rig")
+    # The old Armature modifiers go with Replace Binding, and Predict Skeleton binds nothing: the new one's place.
+    places = [armature_place(obj) if skin is None or replace else binding_place(obj) for obj in meshes]
+    rest = convert.read_rest_shape(meshes, places, depsgraph)
+    mesh = rest.mesh
+    require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
+    _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
+    chosen = meshes
+    meshes, mesh, left_out, notes = _the_character(chosen, mesh, named=named, bound=skin is not None)
+    if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
+        name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
     if skin is not None and not replace:
         bound = [(obj, bound_armature(obj)) for obj in meshes if bound_armature(obj) is not None]
         if bound:
@@ -211,16 +239,57 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
                 f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
                 "it to the new skeleton instead, or remove its Armature modifier first."
             )
-    # The old Armature modifiers go with Replace Binding, and Predict Skeleton binds nothing: the new one's place.
-    places = [armature_place(obj) if skin is None or replace else binding_place(obj) for obj in meshes]
-    rest = convert.read_rest_shape(meshes, places, depsgraph)
-    mesh = rest.mesh
-    require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
-    _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
-    _require_not_flat(meshes, mesh)
+    plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
+                   left_out, notes)
+    _require_not_flat(meshes, plan.character)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
-    return RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor)
+    return plan
+
+
+def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tuple:
+    """Tell the character from what is not (``core.rigging.character_parts``):
+    refuse several characters, naming them; leave out a ground plane and
+    stray specks.
+
+    Parameters
+    ----------
+    meshes : list of bpy.types.Object
+    mesh : Mesh, their rest shape (objects in the order of ``meshes``)
+    named : bool, see :class:`RigPlan`
+    bound : bool, the run binds the meshes (the notes say what is left unbound)
+
+    Returns
+    -------
+    meshes : list of bpy.types.Object, without those wholly left out
+    mesh : Mesh of those meshes
+    left_out : (n',) bool array over its vertices, or None when nothing is left out of them
+    notes : tuple of str
+    """
+    parts = character_parts(mesh)
+    if parts.several:
+        raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
+    dropped = set(parts.whole_objects())
+    kept_rows = np.ones(mesh.vertex_count, dtype=bool)
+    for index in dropped:
+        kept_rows[mesh.object_slice(index)] = False
+    left_out = parts.left_out[kept_rows]
+    return ([obj for index, obj in enumerate(meshes) if index not in dropped], mesh.subset(kept_rows),
+            left_out if left_out.any() else None, tuple(left_out_notes(mesh, parts, bound=bound)))
+
+
+def _one_at_a_time(mesh: Mesh, parts: CharacterParts, named: bool) -> str:
+    """How to rig several characters one at a time, as the run was started
+    (``named``: the user picked the meshes; else the command took every mesh
+    of the file), after separating those joined into one mesh."""
+    pick = ("select one character's meshes and rig it, then the next" if named else
+            "name one character's meshes with --mesh")
+    joined = [name for index, name in enumerate(mesh.object_names)
+              if sum(character[mesh.object_slice(index)].any() for character in parts.characters) > 1]
+    if joined:
+        return (f"first separate the characters joined in {listed_names(joined, quoted=True)} into objects of their "
+                f"own (Edit Mode: Mesh > Separate > By Loose Parts), then {pick}")
+    return pick
 
 
 def _require_rigged_shape_is_seen(meshes, places, rest: convert.RestShape, depsgraph) -> None:
@@ -299,7 +368,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     being closed), the armature is removed and the meshes restored.
     """
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
-    votes = yield lambda progress: predict_votes(plan.mesh, sub_progress(progress, 0.0, share))
+    votes = yield lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share))
     skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
     problems = skeleton_quality(votes, skeleton)
     if problems and not plan.keep_poor:
@@ -312,7 +381,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
         armature.show_in_front = True  # the bones are inside the body
         template = plan.settings.template or DEFAULT_TEMPLATE
         naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
-        notes = (*votes.notes, *template_notes(votes, template), *((naming,) if naming else ()),
+        notes = (*plan.notes, *votes.notes, *template_notes(votes, template), *((naming,) if naming else ()),
                  *(f"poor result kept: {problem}" for problem in problems))
         target = armature
         rig = None
@@ -335,7 +404,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                     for obj in plan.meshes:
                         unbind(obj)
                 skin_plan = plan_skin(target, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
-                                      named=plan.named)
+                                      named=plan.named, left_out=plan.left_out)
                 weights = yield lambda progress: compute_skin(skin_plan, sub_progress(progress, share, 1.0))
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights

@@ -101,12 +101,14 @@ class SkinPlan:
     strays : (n,) bool array over ``mesh``'s vertices, far strays left out of
         the computation and weighted like their nearest kept vertex
         (``core.geometry.outliers``), or None
-    solved : Mesh the weights are computed on: ``mesh`` without ``strays``
+    solved : Mesh the weights are computed on: ``mesh`` without ``strays`` and ``left_out``
     rigid : list of RigidBinding, props bound wholly to the bone they were parented to
     notes : list of str, what the report adds about them, linked duplicates, props left rigid,
         the Armature modifier's place and the artist's groups kept
     rest : convert.RestShape or None, how ``mesh``'s rows map to each object's own vertices
     renames : list of dict, per mesh the artist's groups to keep under a new name (``artist_groups``)
+    left_out : (n,) bool array over ``mesh``'s vertices or None, vertices left unweighted
+        (Auto-Rig: what is not the character, ``core.rigging.character_parts``)
     """
 
     armature: object
@@ -121,6 +123,7 @@ class SkinPlan:
     notes: list = field(default_factory=list)
     rest: convert.RestShape | None = None
     renames: list = field(default_factory=list)
+    left_out: np.ndarray | None = None
 
     @property
     def summary(self) -> str:
@@ -141,7 +144,8 @@ def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str
         )
 
 
-def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True) -> SkinPlan:
+def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True,
+              left_out: np.ndarray | None = None) -> SkinPlan:
     """Read and check the inputs; raises :class:`InputError` on bad input.
 
     Parameters
@@ -154,6 +158,10 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         True when the user named or selected ``meshes``; False when the run
         picked them itself (every mesh of a file): helper objects are then
         left out and props on a bone left rigid.
+    left_out : (n,) bool array or None, vertices of the meshes' rest shape (their
+        rows in ``SkinPlan.mesh``) to leave unweighted: the pieces Auto-Rig
+        found not to be the character (a ground plane, a stray speck). Their
+        Armature modifier leaves them where they are.
     """
     check_skin_method(settings.options.method)
     convert.require_armature_object(armature)
@@ -193,7 +201,10 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     written = [name for name, deform in zip(skeleton.names, skeleton.deform) if deform]
     renames = [{} if settings.replace_all else artist_group_renames(obj, written, armature) for obj in meshes]
     notes += [renames_note(obj.name, renamed) for obj, renamed in zip(meshes, renames) if renamed]
-    solved, strays = split_strays(mesh)
+    if left_out is not None and len(left_out) != mesh.vertex_count:
+        raise InputError(f"{listed_names([obj.name for obj in meshes], quoted=True)} changed while being rigged: "
+                         "run it again.")
+    solved, strays = split_strays(mesh, left_out)
     if solved.bounding_box_diagonal <= 0:
         raise InputError("The mesh has zero size.")
     if strays is not None:
@@ -207,7 +218,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)
     _check_skeleton_fits_mesh(skeleton.deform_subset(), solved, armature.name)
     return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes,
-                    rest, renames)
+                    rest, renames, left_out)
 
 
 def _placement_note(obj, armature, place: int) -> str:
@@ -225,14 +236,18 @@ def _placement_note(obj, armature, place: int) -> str:
 def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> Weights:
     """(n, deform bones) weights for every vertex of every mesh; no ``bpy``.
     Far strays are left out of the computation and take the weights of the
-    nearest kept vertex (``core.geometry.outliers.rows_for_strays``)."""
+    nearest kept vertex (``core.geometry.outliers.rows_for_strays``); the
+    plan's ``left_out`` vertices get rows of zeros."""
     if plan.mesh is None:
         names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
         return Weights(np.zeros((0, len(names))), names)
     weights = skin_weights(plan.solved, plan.skeleton, plan.settings.options, progress=progress)
-    if plan.strays is None:
+    if plan.strays is None and plan.left_out is None:
         return weights
-    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, plan.strays)
+    left_out = plan.left_out if plan.left_out is not None else np.zeros(plan.mesh.vertex_count, dtype=bool)
+    strays = plan.strays if plan.strays is not None else np.zeros(plan.mesh.vertex_count, dtype=bool)
+    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, strays | left_out)
+    rows[left_out] = 0.0
     return Weights(rows, weights.bone_names)
 
 
