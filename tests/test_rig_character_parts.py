@@ -168,11 +168,12 @@ def test_two_characters_are_refused_naming_them_and_the_scene_is_unchanged(clean
         assert scene_state(objects) == before and len(bpy.data.armatures) == 0
 
 
-def test_a_sword_beside_the_character_is_not_a_second_character(clean_scene):
+def test_a_sword_beside_the_character_is_not_a_second_character(clean_scene, capfd):
     """A blade 0.45 long lying on the ground 0.3 beside the biped (4 % of the
-    area, 1 cm tall) is not refused as a second character: it is rigged with
-    the character, as before. The prediction still reads it, and the feet
-    come out poor: kept here with Keep Poor Result."""
+    area, 1 cm tall) is not refused as a second character: it is a prop set
+    down (``core.rigging.props``), left out of the skeleton and not bound.
+    Before props were told apart, the prediction read it and the feet came
+    out poor."""
     body = add_biped()
     feet = biped_geometry()[0][:, 2].min()
     blade = box_mesh([0.6, -0.22, feet], [0.63, 0.23, feet + 0.01], 0.01)
@@ -180,10 +181,13 @@ def test_a_sword_beside_the_character_is_not_a_second_character(clean_scene):
     bpy.context.view_layer.update()
     select_only([body, sword], active=body)
 
-    assert bpy.ops.autorig.auto_rig(rig_keep_poor=True) == {"FINISHED"}
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
 
     (armature,) = armatures()
-    assert body.parent == armature and sword.parent == armature
+    assert_skeleton_within_the_biped(armature)
+    assert body.parent == armature and sword.parent is None and len(sword.modifiers) == 0
+    assert ("'Sword' lies 0.468 m from the character and nothing holds it: left out of the skeleton and not bound "
+            "(a prop set down?)") in capfd.readouterr().out
 
 
 def run_main(arguments, capsys):

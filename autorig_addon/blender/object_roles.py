@@ -11,6 +11,9 @@
   is replaced by the armature (:class:`RigidBinding`), keeping their rest
   position, so posing moves them exactly as before. A mesh is never both
   deformed by an Armature modifier and carried by a bone.
+- **Props held as objects of their own** (a sword, a shield, a mug; told
+  from the body by Auto-Rig, ``core.rigging.props``): bound wholly to the
+  bone nearest to where they are held (:func:`held_binding`).
 - **Linked duplicates** (Alt+D: two gloves sharing one mesh): weights live
   in the mesh, so each object written gets a mesh of its own first
   (:func:`give_own_mesh`), or the second glove would overwrite the first's.
@@ -25,13 +28,16 @@ from mathutils import Matrix
 
 from ..core.errors import InputError
 from ..core.messages import listed_names
+from ..core.rigging.props import held_note, holding_bone
+from ..core.types import Skeleton
 from .armature_binding import bone_parent, objects_at_rest
 from .convert import deform_bone_names
 
 
 @dataclass(frozen=True)
 class RigidBinding:
-    """A prop parented to a bone, to be bound wholly to that bone.
+    """A prop to be bound wholly to one bone: the bone it was parented to,
+    or the one holding it (``held``).
 
     Attributes
     ----------
@@ -40,16 +46,20 @@ class RigidBinding:
     bone : str, the bone's name (a deform bone)
     rest_world : mathutils.Matrix, the object's world matrix with the armature
         in its rest position: where the Armature modifier must start from
+    held : bool, a prop told from the body (``core.rigging.props``), not parented to the bone
     """
 
     obj: object
     armature: object
     bone: str
     rest_world: Matrix
+    held: bool = False
 
     @property
     def note(self) -> str:
         """What the report says about the object (after its name)."""
+        if self.held:
+            return held_note(self.bone)
         return f"bound wholly to bone '{self.bone}' (it was parented to that bone)"
 
 
@@ -82,6 +92,16 @@ def rigid_binding(obj, armature) -> RigidBinding | None:
     with objects_at_rest([obj]):
         rest_world = obj.matrix_world.copy()
     return RigidBinding(obj, armature, bone, rest_world)
+
+
+def held_binding(obj, armature, grip, skeleton: Skeleton) -> RigidBinding:
+    """How to bind ``obj``, a prop the character holds (``core.rigging.props``),
+    to ``armature``: wholly to the deform bone of ``skeleton`` (the
+    armature's, world space) nearest to its ``grip`` (3,), from where it
+    stands now."""
+    with objects_at_rest([obj]):
+        rest_world = obj.matrix_world.copy()
+    return RigidBinding(obj, armature, holding_bone(grip, skeleton), rest_world, held=True)
 
 
 def split_bone_parented(objects: list, armature, named: bool) -> tuple[list, list, list]:

@@ -4,10 +4,13 @@ file and (unless ``--skin none``) bind them to it with skin weights.
 Each input holds one character: the meshes named with ``--mesh``, else
 every mesh of the file except helpers (bone shapes, objects hidden from
 render). A file holding several characters apart is refused, naming them:
-rig each with ``--mesh``. A file that already holds an
+rig each with ``--mesh``. Rigid props of their own (a sword, a shield) get
+no bones: they are bound wholly to the bone holding them
+(``core.rigging.props``). A file that already holds an
 armature is refused unless ``--replace``, which removes the armatures, the
 meshes' Armature modifiers and the vertex groups named after their bones
-first. The options are made from the rig option table
+first, and takes what the bones carried (KayKit's swords) off them where it
+is at rest. The options are made from the rig option table
 (``core.rigging.options.RIG_OPTIONS``), the one the Blender panel is made
 from; ``--skin`` takes the skinning methods of ``core.skinning.methods``.
 """
@@ -61,7 +64,7 @@ def clear_armatures(replace: bool) -> list[str]:
     the names of the removed armatures."""
     import bpy
 
-    from ..blender.armature_binding import clear_parent_keep_world, remove_armature, unbind
+    from ..blender.armature_binding import clear_parent_keep_world, pose_position, remove_armature, unbind
     from ..blender.selection import file_meshes
 
     armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
@@ -71,11 +74,14 @@ def clear_armatures(replace: bool) -> list[str]:
     if not replace:
         raise InputError(f"The file already holds an armature ({listed_names(names, quoted=True)}): pass --replace "
                          "to remove it and rig the meshes anew.")
-    for obj in file_meshes():
-        unbind(obj)
-    for obj in bpy.data.objects:
-        if obj.parent in armatures:
-            clear_parent_keep_world(obj)
+    # At rest: the unbound meshes take their rest shape, so what the bones carried (a sword on the hand's bone)
+    # must stay where it is at rest too, not where the file's pose held it.
+    with pose_position(armatures):
+        for obj in file_meshes():
+            unbind(obj)
+        for obj in bpy.data.objects:
+            if obj.parent in armatures:
+                clear_parent_keep_world(obj)
     for armature in armatures:
         remove_armature(armature)
     return names

@@ -49,6 +49,7 @@ from ...core.rigging.predict import (
     skeleton_quality,
     template_notes,
 )
+from ...core.rigging.props import prop_notes, rigid_props
 from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
 from ...core.skeleton.name_presets import DEFAULT_PRESET
@@ -139,6 +140,9 @@ class RigPlan:
         (a ground plane, stray specks: ``core.rigging.character_parts``), left out of the prediction and
         left unweighted
     notes : tuple of str, what the report says about what was left out
+    held : tuple of (bpy.types.Object, (3,) float array): rigid props the character holds, not among
+        ``meshes`` (``core.rigging.props``), and their grip (world space); Auto-Rig binds each wholly to
+        the deform bone nearest to its grip
     """
 
     meshes: list
@@ -152,6 +156,7 @@ class RigPlan:
     keep_poor: bool = False
     left_out: np.ndarray | None = None
     notes: tuple = ()
+    held: tuple = ()
 
     @property
     def character(self) -> Mesh:
@@ -202,6 +207,8 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     apart here: a ground plane and stray specks are left out (a mesh wholly
     left out is dropped from the plan, so it is not bound; the plan's notes
     say so), and meshes holding several characters are refused, naming them.
+    Rigid props (``core.rigging.props``) are dropped from the meshes too:
+    those the character holds are the plan's ``held``, the others are not bound.
 
     Parameters
     ----------
@@ -228,11 +235,12 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
     chosen = meshes
-    meshes, mesh, left_out, notes = _the_character(chosen, mesh, named=named, bound=skin is not None)
+    meshes, mesh, left_out, notes, held = _the_character(chosen, mesh, named=named, bound=skin is not None)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
     if skin is not None and not replace:
-        bound = [(obj, bound_armature(obj)) for obj in meshes if bound_armature(obj) is not None]
+        bound = [(obj, bound_armature(obj)) for obj in meshes + [obj for obj, _ in held]
+                 if bound_armature(obj) is not None]
         if bound:
             obj, armature = bound[0]
             raise InputError(
@@ -240,7 +248,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
                 "it to the new skeleton instead, or remove its Armature modifier first."
             )
     plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
-                   left_out, notes)
+                   left_out, notes, held)
     _require_not_flat(meshes, plan.character)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
@@ -248,9 +256,9 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
 
 
 def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tuple:
-    """Tell the character from what is not (``core.rigging.character_parts``):
-    refuse several characters, naming them; leave out a ground plane and
-    stray specks.
+    """Tell the character from what is not (``core.rigging.character_parts``,
+    ``core.rigging.props``): refuse several characters, naming them; leave
+    out a ground plane, stray specks and rigid props.
 
     Parameters
     ----------
@@ -265,17 +273,21 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tup
     mesh : Mesh of those meshes
     left_out : (n',) bool array over its vertices, or None when nothing is left out of them
     notes : tuple of str
+    held : tuple of (bpy.types.Object, (3,) array), the props held and their grip (see :class:`RigPlan`)
     """
     parts = character_parts(mesh)
     if parts.several:
         raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
-    dropped = set(parts.whole_objects())
+    props = rigid_props(mesh, parts.left_out)
+    dropped = set(parts.whole_objects()) | {prop.object_index for prop in props}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:
         kept_rows[mesh.object_slice(index)] = False
     left_out = parts.left_out[kept_rows]
+    notes = (*left_out_notes(mesh, parts, bound=bound), *prop_notes(mesh, props, bound=bound))
+    held = tuple((meshes[prop.object_index], prop.grip) for prop in props if prop.held)
     return ([obj for index, obj in enumerate(meshes) if index not in dropped], mesh.subset(kept_rows),
-            left_out if left_out.any() else None, tuple(left_out_notes(mesh, parts, bound=bound)))
+            left_out if left_out.any() else None, notes, held)
 
 
 def _one_at_a_time(mesh: Mesh, parts: CharacterParts, named: bool) -> str:
@@ -374,7 +386,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     if problems and not plan.keep_poor:
         raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
                          "Template, or keep it anyway with Keep Poor Result (--keep-poor).")
-    replaced = _followed_armatures(plan.meshes) if plan.skin is not None and plan.replace else []
+    bound = plan.meshes + [obj for obj, _ in plan.held]
+    replaced = _followed_armatures(bound) if plan.skin is not None and plan.replace else []
     armature = build_armature(skeleton, plan.name, context)
     created = [armature]
     try:
@@ -399,12 +412,12 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
         if plan.skin is not None:
-            with restored_on_failure(plan.meshes):
+            with restored_on_failure(bound):
                 if plan.replace:
-                    for obj in plan.meshes:
+                    for obj in bound:
                         unbind(obj)
                 skin_plan = plan_skin(target, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
-                                      named=plan.named, left_out=plan.left_out)
+                                      named=plan.named, left_out=plan.left_out, held=plan.held)
                 weights = yield lambda progress: compute_skin(skin_plan, sub_progress(progress, share, 1.0))
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights

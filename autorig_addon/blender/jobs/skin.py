@@ -10,8 +10,8 @@ As with transfer, nothing is written before everything is computed:
 3. :func:`write_skin` writes every mesh, restoring all of them if any
    write fails.
 
-What the plan does with props parented to a bone, helper objects, linked
-duplicates and stray vertices: :mod:`..object_roles` and
+What the plan does with props parented to a bone or held (Auto-Rig), helper
+objects, linked duplicates and stray vertices: :mod:`..object_roles` and
 :mod:`autorig_addon.core.geometry.outliers`; each is named in the report.
 The weights are computed on the shape the Armature modifier deforms, a
 Mirror modifier's mirrored half included (:mod:`..modifier_stack`), and
@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from dataclasses import dataclass, field
+from typing import Sequence
 
 import numpy as np
 
@@ -38,7 +39,14 @@ from ...core.types import Mesh, Skeleton, Weights
 from .. import convert
 from ..artist_groups import artist_group_renames, renamed_artist_groups, renames_note
 from ..modifier_stack import REST_SHAPE_TYPES, binding_place, kept_armature_modifier, vertex_adders
-from ..object_roles import give_own_mesh, left_rigid_note, shared_mesh_notes, split_bone_parented, without_helpers
+from ..object_roles import (
+    give_own_mesh,
+    held_binding,
+    left_rigid_note,
+    shared_mesh_notes,
+    split_bone_parented,
+    without_helpers,
+)
 from ..snapshot import restored_on_failure
 from ..weight_writer import bind_to_bone, write_weights
 from .input_checks import check_mode, split_strays, stray_notes
@@ -102,7 +110,7 @@ class SkinPlan:
         the computation and weighted like their nearest kept vertex
         (``core.geometry.outliers``), or None
     solved : Mesh the weights are computed on: ``mesh`` without ``strays`` and ``left_out``
-    rigid : list of RigidBinding, props bound wholly to the bone they were parented to
+    rigid : list of RigidBinding, props bound wholly to the bone they were parented to or that holds them
     notes : list of str, what the report adds about them, linked duplicates, props left rigid,
         the Armature modifier's place and the artist's groups kept
     rest : convert.RestShape or None, how ``mesh``'s rows map to each object's own vertices
@@ -145,7 +153,7 @@ def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str
 
 
 def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True,
-              left_out: np.ndarray | None = None) -> SkinPlan:
+              left_out: np.ndarray | None = None, held: Sequence = ()) -> SkinPlan:
     """Read and check the inputs; raises :class:`InputError` on bad input.
 
     Parameters
@@ -162,6 +170,10 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         rows in ``SkinPlan.mesh``) to leave unweighted: the pieces Auto-Rig
         found not to be the character (a ground plane, a stray speck). Their
         Armature modifier leaves them where they are.
+    held : sequence of (bpy.types.Object, (3,) array): props Auto-Rig found
+        the character holds, not among ``meshes``, and their grip (world
+        space, ``core.rigging.props``): each is bound wholly to the deform
+        bone nearest to its grip.
     """
     check_skin_method(settings.options.method)
     convert.require_armature_object(armature)
@@ -185,6 +197,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     if not skeleton.deform.any():
         raise InputError(f"The armature '{armature.name}' has no deform bones: enable Deform on the bones to weight.")
     meshes, rigid, left_rigid = split_bone_parented(meshes, armature, named)
+    rigid += [held_binding(obj, armature, grip, skeleton) for obj, grip in held]
     # Named props left rigid sit on a bone that does not deform.
     notes = [f"'{obj.name}' {left_rigid_note(obj)}" + (" (it does not deform)" if named else "") for obj in left_rigid]
     notes += [f"'{binding.obj.name}' {binding.note}" for binding in rigid]

@@ -1,0 +1,325 @@
+"""Rigid props: separate objects the character holds or carries (a sword,
+an axe, a shield, a mug, a quiver), told from its body.
+
+A prop rigged with the character (selected with it, or every mesh of a file)
+was read by the skeleton prediction as part of the body: a sword's tip got a
+bone floating far from the hand, its blade was split over two bones, and
+KayKit's knight with its swords and shields got 106 bones instead of 25.
+Its place is one bone: the one that holds it. This module tells props from
+the body from the shapes alone (world space), object by object, after
+:mod:`.character_parts` has left out a ground plane and stray specks. An
+object is a prop when:
+
+1. **it is small**: under :data:`PROP_AREA_SHARE` of the area of the
+   character's other objects;
+2. **it has no twin**: under :data:`TWIN_SHARE` of its surface, mirrored
+   across the body's left-right mirror plane, lies on the character's
+   surface (within :data:`NEAR_SHARE` of the body's largest side). A body
+   part that is an object of its own (KayKit's arms, legs, head), boots,
+   gloves, eyes, a helmet or a cape lies across the plane or has a twin:
+   96-100 % of it on KayKit's knight, barbarian, rogue and ranger at rest;
+   their shields, two-handed axe, crossbows, mug and quiver 19-63 %;
+3. **it sticks out of the body**: over :data:`OUT_SHARE` of its area lies
+   farther than :data:`NEAR_SHARE` of the body's largest side from the
+   body's surface (the objects that are not small and twinless). Clothes,
+   armour, a pouch or an eye patch lie on the body and stay.
+
+The mirror plane runs across x or across y, through the body's bounding-box
+centre or the median of its surface, whichever mirrors it best; for each,
+the twinless objects are told and the body is told again without them, until
+they settle (at most :data:`PASSES` times: a prop widens the body's box on
+one side). The plane leaving the body most symmetric is taken, and the body
+must be symmetric across it (:data:`.symmetry.SYMMETRY_TOLERANCE`), or no
+prop is told: a posed character's own parts lack twins, and leaving an arm
+out of the skeleton would be worse than giving a sword bones. Where the
+other plane mirrors the body about as well (a round body; not
+:data:`.symmetry.CLEARLY_BETTER`), a prop must lack a twin across both. A
+prop on the mirror plane (a staff held centred in both hands) or a pair of
+them (a sword in each hand, mirrored) has a twin and stays part of the body.
+
+A prop is **held** when it comes within :data:`NEAR_SHARE` of the body's
+largest side of the body's surface. Its **grip** is the mean of its surface
+points that near the body (the handle in the fist, a shield's straps on the
+forearm): the rig job binds it wholly to the deform bone whose segment lies
+nearest to the grip (:func:`holding_bone`). A prop farther away (set down
+beside the character) is left out and not bound.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..geometry.bounding_box import largest_side
+from ..geometry.closest_point import TriangleMeshQuery
+from ..geometry.normals import triangle_double_areas
+from ..geometry.segments import closest_segments
+from ..types import Mesh, Skeleton
+from .character_parts import distance_text
+from .nearest_character import surface_points
+from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE
+
+#: A prop holds under this share of the area of the character's other objects (KayKit's two-handed axe: 11 %).
+PROP_AREA_SHARE = 0.15
+#: An object with at least this share of its surface mirrored onto the character's has a twin (or is its own).
+TWIN_SHARE = 0.8
+#: Near the body's surface: within this share of the body's largest side (5 cm on a 1.8 m human).
+NEAR_SHARE = 0.03
+#: A prop has over this share of its area farther than :data:`NEAR_SHARE` from the body.
+OUT_SHARE = 0.5
+#: Points drawn on the character's surface to tell whether a mirrored point lies on it, the nearest one looked up
+#: (on a human about 0.3 % of its largest side apart, a tenth of :data:`NEAR_SHARE`; exact closest points on the
+#: triangles made 300 hair cards cost 7 s instead of 2).
+SURFACE_SAMPLES = 65536
+#: Points drawn on each object's surface, uniformly by area (a share within about 2 %) ...
+SAMPLES_PER_OBJECT = 512
+#: ... fewer when there are many objects (hundreds of hair cards), these many on them all ...
+SAMPLE_BUDGET = 16384
+#: ... but at least these many on each (a share within about 6 %).
+FEWEST_SAMPLES = 64
+#: Points drawn on the body's surface to measure its symmetry, pairs of them voting for where its mirror
+#: plane lies (memory grows as the square of their count) ...
+BODY_SAMPLES = 2048
+#: ... for this many places, each tried with the plane through the body's box centre and its median ...
+VOTED_PLANES = 4
+#: ... on the first this many of them.
+CHOOSING_SAMPLES = 512
+#: Most times the body and its mirror plane are told, each time without the objects found twinless the time before.
+PASSES = 8
+#: Mirror errors (share of the largest side) below this are equal: a symmetric mesh's mirror lands on itself.
+MIRROR_NOISE = 1e-3
+
+
+@dataclass(frozen=True)
+class Prop:
+    """An object of the character that is a rigid prop (:func:`rigid_props`).
+
+    Attributes
+    ----------
+    object_index : int, the object in the mesh's ``object_names``
+    grip : (3,) float array, world space: where it holds on to the body (held), or its point nearest the body
+    gap : float, the smallest distance from its vertices and surface points to the body's surface (about 0
+        where they meet), scene units
+    held : bool, it comes within :data:`NEAR_SHARE` of the body's largest side of the body
+    """
+
+    object_index: int
+    grip: np.ndarray
+    gap: float
+    held: bool
+
+
+def rigid_props(mesh: Mesh, left_out: np.ndarray | None = None) -> tuple[Prop, ...]:
+    """The objects of ``mesh`` that are rigid props (see the module docstring),
+    in the objects' order.
+
+    Parameters
+    ----------
+    mesh : Mesh, world space, one or more objects
+    left_out : (n,) bool array or None, vertices that are not the character
+        (``character_parts``): triangles touching them are neither a prop nor the body
+
+    Returns
+    -------
+    tuple of Prop, empty when the body is not left-right symmetric or there is one object
+    """
+    vertices = mesh.vertices
+    kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
+    triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)] if len(mesh.triangles) else mesh.triangles
+    triangles = triangles[triangle_double_areas(vertices, triangles) > 0]
+    owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
+    if len(np.unique(owner)) < 2:
+        return ()
+    objects = _Objects(vertices, {int(index): triangles[owner == index] for index in np.unique(owner)},
+                       cKDTree(surface_points(vertices, triangles, SURFACE_SAMPLES)))
+    area = {index: 0.5 * float(triangle_double_areas(vertices, own).sum()) for index, own in objects.own.items()}
+    total_area = sum(area.values())
+    # An object with pieces left out (a stray speck in it) is not bound whole: it is never a prop.
+    small = {index for index in objects.own if kept[mesh.object_slice(index)].all()
+             and area[index] < PROP_AREA_SHARE * (total_area - area[index])}
+    if not small:
+        return ()
+    # Only a symmetric body tells twins from twinless parts (the objects told with it may have made it lopsided).
+    tellings = {}
+    for axis in (0, 1):
+        told = _twinless(objects, small, axis)
+        if told is not None and told[0] <= SYMMETRY_TOLERANCE:
+            tellings[axis] = told[1]
+    if len(tellings) == 2:
+        tellings = _mirror_planes(objects, tellings)
+    candidates = set.intersection(*tellings.values()) if tellings else set()
+    if not candidates:
+        return ()
+    body = objects.triangles_without(candidates)
+    near = NEAR_SHARE * largest_side(vertices[np.unique(body)])
+    body_query = TriangleMeshQuery(vertices, body)
+    props = []
+    for index in sorted(candidates):
+        points = objects.samples[index]
+        distances = body_query.closest(points).distances
+        if np.mean(distances > near) <= OUT_SHARE:
+            continue  # it lies on the body: clothing, armour
+        own_vertices = vertices[np.unique(objects.own[index])]
+        gap = min(float(distances.min()), float(body_query.closest(own_vertices).distances.min()))
+        touching = distances <= near
+        grip = points[touching].mean(axis=0) if touching.any() else points[np.argmin(distances)]
+        props.append(Prop(index, grip, gap, gap <= near))
+    return tuple(props)
+
+
+@dataclass
+class _Objects:
+    """The objects of a mesh with an area: (m_i, 3) triangles of each
+    (``own``, by object index), points drawn on each (``samples``:
+    :data:`SAMPLES_PER_OBJECT`, fewer when there are many objects, down to
+    :data:`FEWEST_SAMPLES`) and a tree of :data:`SURFACE_SAMPLES` points
+    drawn on them all (``surface``)."""
+
+    vertices: np.ndarray
+    own: dict
+    surface: cKDTree
+    samples: dict = field(init=False)
+
+    def __post_init__(self):
+        count = max(FEWEST_SAMPLES, min(SAMPLES_PER_OBJECT, SAMPLE_BUDGET // len(self.own)))
+        self.samples = {index: surface_points(self.vertices, own, count) for index, own in self.own.items()}
+
+    def triangles_without(self, left: set) -> np.ndarray:
+        """(m, 3) the triangles of the objects not in ``left`` (empty for none)."""
+        rest = [own for index, own in self.own.items() if index not in left]
+        return np.concatenate(rest) if rest else np.zeros((0, 3), dtype=np.int64)
+
+
+def _twinless(objects: _Objects, small: set, axis: int) -> tuple[float, set] | None:
+    """The ``small`` objects without a twin across the body's mirror plane
+    perpendicular to ``axis`` (module docstring), told again without those
+    found the time before until they settle: ``(error, twinless)``, the
+    error of the body's plane (:func:`_mirror_plane`); None when they never
+    settle or nothing is left of the body."""
+    chosen = sorted(small)
+    # All of their points are queried at once: one query per object costs more than the query itself.
+    points = np.concatenate([objects.samples[index] for index in chosen])
+    counts = np.array([len(objects.samples[index]) for index in chosen])
+    owner = np.repeat(np.arange(len(chosen)), counts)
+    twinless: set = set()
+    for _ in range(PASSES):
+        body = objects.triangles_without(twinless)
+        if not len(body):
+            return None
+        centre, size, error = _mirror_plane(objects.vertices, body, axis)
+        near = NEAR_SHARE * size
+        on_surface = objects.surface.query(_mirrored(points, axis, centre), distance_upper_bound=near)[0] <= near
+        twin_share = np.bincount(owner, weights=on_surface, minlength=len(chosen)) / counts
+        found = {index for index, share in zip(chosen, twin_share) if share < TWIN_SHARE}
+        if found == twinless:
+            return error, twinless
+        twinless = found
+    return None
+
+
+def _mirror_planes(objects: _Objects, tellings: dict) -> dict:
+    """Of two tellings ``{axis: twinless}``, each leaving the body symmetric
+    across its plane, the one whose plane mirrors the body clearly better
+    (:data:`.symmetry.CLEARLY_BETTER`), both when neither does (a round
+    body). They are compared on the same body, without the objects either
+    found twinless: a plane that found more of them twinless must not win
+    by what it left out (a cape, twinless front to back)."""
+    body = objects.triangles_without(set.union(*tellings.values()))
+    if not len(body):
+        return {}
+    errors = {axis: max(_mirror_plane(objects.vertices, body, axis)[2], MIRROR_NOISE) for axis in tellings}
+    best = min(errors, key=errors.get)
+    clearly = all(errors[best] < CLEARLY_BETTER * error for axis, error in errors.items() if axis != best)
+    return {best: tellings[best]} if clearly else tellings
+
+
+def _mirror_plane(vertices: np.ndarray, triangles: np.ndarray, axis: int) -> tuple[float, float, float]:
+    """The body's mirror plane perpendicular to ``axis``, ``x[axis] =
+    centre``: of the planes through its bounding-box centre, the median of
+    its surface and the centres its surface votes for
+    (:func:`_voted_centres`; a prop the body was told with widens its box
+    and moves its median), the one that mirrors its surface best. Returns
+    ``(centre, largest side, error)``, the error being the mean distance
+    from the mirrored surface to the surface, as a share of the largest side
+    (inf for a body of no size)."""
+    corners = vertices[np.unique(triangles)]
+    size = largest_side(corners)
+    if size <= 0:
+        return 0.0, 0.0, np.inf
+    query = TriangleMeshQuery(vertices, triangles)
+    points = surface_points(vertices, triangles, BODY_SAMPLES)
+    centres = (0.5 * float(corners[:, axis].min() + corners[:, axis].max()), float(np.median(points[:, axis])),
+               *_voted_centres(points, axis, NEAR_SHARE * size))
+    # The planes are told apart on a few of the points, the error of the one chosen measured on all.
+    _, centre = min((float(query.closest(_mirrored(points[:CHOOSING_SAMPLES], axis, centre)).distances.mean()),
+                     centre) for centre in centres)
+    return centre, size, float(query.closest(_mirrored(points, axis, centre)).distances.mean()) / size
+
+
+def _voted_centres(points: np.ndarray, axis: int, near: float) -> list[float]:
+    """Where the mirror plane perpendicular to ``axis`` may lie: pairs of
+    ``points`` (k, 3) level with each other across it (their other two
+    coordinates within a third of ``near``) and farther apart than ``near``
+    along it vote for their midpoint, in bins a third of ``near`` wide; the
+    mean midpoint of each of the :data:`VOTED_PLANES` fullest bins, none
+    next to another (a mirror's pairs all vote for one bin)."""
+    width = near / 3.0
+    if width <= 0:
+        return []
+    level = [other for other in range(3) if other != axis]
+    pairs = cKDTree(points[:, level]).query_pairs(width, output_type="ndarray")
+    first, second = points[pairs[:, 0], axis], points[pairs[:, 1], axis]
+    midpoints = (0.5 * (first + second))[np.abs(first - second) > near]
+    if not len(midpoints):
+        return []
+    bins = np.floor(midpoints / width).astype(np.int64)
+    values, counts = np.unique(bins, return_counts=True)
+    chosen: list = []
+    for value in values[np.argsort(-counts, kind="stable")]:
+        if all(abs(value - other) > 1 for other in chosen):
+            chosen.append(value)
+        if len(chosen) == VOTED_PLANES:
+            break
+    return [float(midpoints[np.abs(bins - value) <= 1].mean()) for value in chosen]
+
+
+def _mirrored(points: np.ndarray, axis: int, centre: float) -> np.ndarray:
+    """(k, 3) ``points`` mirrored across the plane ``x[axis] = centre``."""
+    mirrored = points.copy()
+    mirrored[:, axis] = 2.0 * centre - mirrored[:, axis]
+    return mirrored
+
+
+def holding_bone(grip: np.ndarray, skeleton: Skeleton) -> str:
+    """The deform bone holding a prop: the one whose segment (head to tail)
+    lies nearest to its ``grip`` (3,) (a sword's grip in the fist: the hand;
+    with Rigify's rig, its DEF- bone). ``skeleton`` needs a deform bone."""
+    deform = np.flatnonzero(skeleton.deform)
+    index, _ = closest_segments(np.asarray(grip, dtype=np.float64)[None], skeleton.joints[deform],
+                                skeleton.tails[deform])
+    return skeleton.names[deform[int(index[0])]]
+
+
+# --------------------------------------------------------------------------- wording
+
+
+def held_note(bone: str) -> str:
+    """What the report says, after a held prop's name, once it is bound."""
+    return f"held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)"
+
+
+def prop_notes(mesh: Mesh, props, *, bound: bool) -> list[str]:
+    """What the report says about each prop before the skeleton exists
+    (``bound``: the run binds the meshes; a held prop's note then comes
+    with its bone, :func:`held_note`)."""
+    notes = []
+    for prop in props:
+        name = mesh.object_names[prop.object_index]
+        if not prop.held:
+            notes.append(f"'{name}' lies {distance_text(prop.gap)} from the character and nothing holds it: left out "
+                         "of the skeleton" + (" and not bound" if bound else "") + " (a prop set down?)")
+        elif not bound:
+            notes.append(f"'{name}' is held: a rigid prop, left out of the skeleton")
+    return notes

@@ -1,0 +1,236 @@
+"""Rigid props of their own in Predict Skeleton, Auto-Rig and the ``rig``
+command (``core.rigging.props`` through ``blender.jobs.rig``): a sword held
+in the procedural biped's right hand gets no bones and is bound wholly to
+the hand; a helmet and a bracer lying on the body are skinned as before.
+Built as a user builds them, with real bpy."""
+
+import json
+from itertools import combinations
+
+import bpy
+import numpy as np
+import pytest
+
+from autorig_addon.blender import convert, scene_io
+from autorig_addon.blender.armature_builder import build_armature
+from autorig_addon.cli.main import main
+from autorig_addon.core.geometry.normals import vertex_normals
+from autorig_addon.core.geometry.segments import point_segment_distances
+from autorig_addon.core.procedural import generate_character
+from blender_fixtures import (
+    bind,
+    evaluated_world_vertices,
+    group_weights,
+    mesh_object,
+    parent_to_bone,
+    pose_bone_turned,
+    scene_state,
+    select_only,
+)
+from geometry_fixtures import box_mesh
+
+pytestmark = pytest.mark.all_blenders
+
+#: The procedural biped (0.94 tall, facing -Y, arms out and down; its right hand around x -0.28, z 0.57).
+BIPED_SEED = 0
+#: The sword: a blade 1.6 cm square from its pommel 3 cm behind the right hand to its tip 0.5 forward.
+SWORD_LOW, SWORD_HIGH = (-0.286, -0.5, 0.565), (-0.27, 0.03, 0.581)
+#: Where the sword passes through the right hand.
+GRIP = np.array([-0.278, -0.01, 0.573])
+#: The holding bone passes this close to the grip (the hand is about 4 cm across).
+GRIP_DISTANCE = 0.03
+#: Sword vertices this far before the hand are its blade: no bone may come this close to them.
+BLADE_CLEARANCE = 0.1
+
+
+def armatures():
+    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+
+
+def add_biped():
+    mesh = generate_character(BIPED_SEED, "biped").mesh
+    obj = mesh_object("Biped", mesh.vertices, mesh.triangles)
+    bpy.context.view_layer.update()
+    return obj
+
+
+def add_sword():
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    obj = mesh_object("Sword", blade.vertices, blade.triangles)
+    bpy.context.view_layer.update()
+    return obj
+
+
+def add_shell(name, rows_of):
+    """A garment as a user makes one: the body's faces whose corners all
+    pass ``rows_of(vertices)`` duplicated and pushed 1 cm out along the
+    normals (Shift+D, P, Alt+S)."""
+    mesh = generate_character(BIPED_SEED, "biped").mesh
+    normals = vertex_normals(mesh.vertices, mesh.triangles)
+    chosen = rows_of(mesh.vertices)
+    kept = mesh.triangles[chosen[mesh.triangles].all(axis=1)]
+    used, triangles = np.unique(kept, return_inverse=True)
+    obj = mesh_object(name, mesh.vertices[used] + 0.01 * normals[used], triangles.reshape(-1, 3))
+    bpy.context.view_layer.update()
+    return obj
+
+
+def blade_vertices(sword) -> np.ndarray:
+    world = evaluated_world_vertices(sword)
+    return world[world[:, 1] < GRIP[1] - BLADE_CLEARANCE]
+
+
+def pairwise_distances(points) -> np.ndarray:
+    return np.array([np.linalg.norm(a - b) for a, b in combinations(points, 2)])
+
+
+def assert_no_bone_near_the_blade(armature, sword):
+    skeleton = convert.read_skeleton(armature)
+    blade = blade_vertices(sword)
+    distances = point_segment_distances(blade, skeleton.joints, skeleton.tails)
+    assert distances.min() > BLADE_CLEARANCE - 0.05
+
+
+def turn_fk_hand(rig, degrees: float) -> None:
+    """Turn Rigify's FK hand control of the right arm (its deform bone follows it), the arm switched to FK."""
+    rig.pose.bones["upper_arm_parent.R"]["IK_FK"] = 1.0
+    pose_bone_turned(rig, "hand_fk.R", degrees)
+
+
+def assert_bound_wholly_to(sword, armature, bone: str, turn=None):
+    """Every sword vertex weighs exactly 1 on ``bone`` and nothing else, and
+    posing that bone by 30 degrees (``turn(armature, degrees)``, by default
+    turning the pose bone itself) moves the sword without bending it."""
+    skeleton = convert.read_skeleton(armature)
+    weights = group_weights(sword, skeleton.names)
+    column = skeleton.names.index(bone)
+    assert np.array_equal(weights[:, column], np.ones(len(sword.data.vertices)))
+    assert not np.delete(weights, column, axis=1).any()
+    modifiers = [modifier for modifier in sword.modifiers if modifier.type == "ARMATURE"]
+    assert len(modifiers) == 1 and modifiers[0].object == armature and sword.parent == armature
+    head, tail = skeleton.joints[column], skeleton.tails[column]
+    assert point_segment_distances(GRIP[None], head[None], tail[None])[0, 0] < GRIP_DISTANCE
+    rest = evaluated_world_vertices(sword)
+    if turn is None:
+        pose_bone_turned(armature, bone, 30.0)
+    else:
+        turn(armature, 30.0)
+    posed = evaluated_world_vertices(sword)
+    assert np.linalg.norm(posed - rest, axis=1).max() > 0.05
+    np.testing.assert_allclose(pairwise_distances(posed), pairwise_distances(rest), atol=1e-5)
+
+
+def test_auto_rig_gives_a_held_sword_no_bones_and_binds_it_wholly_to_the_hand(clean_scene, capfd):
+    """Before, the sword was read as part of the body and skinned smoothly
+    over the arm's bones, so posing the hand bent its blade."""
+    body = add_biped()
+    select_only([body], active=body)
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (alone,) = armatures()
+    bones_alone = [bone.name for bone in alone.data.bones]
+    bpy.data.objects.remove(alone)
+    sword = add_sword()
+    select_only([body, sword], active=sword)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert armature.name == "Biped_rig"
+    assert [bone.name for bone in armature.data.bones] == bones_alone
+    assert_no_bone_near_the_blade(armature, sword)
+    skeleton = convert.read_skeleton(armature)
+    np.testing.assert_allclose(group_weights(body, skeleton.names).sum(axis=1), 1.0, atol=1e-5)
+    assert "'Sword' held: bound wholly to bone 'hand.R' (a rigid prop, left out of the skeleton)" \
+        in capfd.readouterr().out
+    assert_bound_wholly_to(sword, armature, "hand.R")
+
+
+def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, capfd):
+    body, sword = add_biped(), add_sword()
+    select_only([body, sword], active=body)
+    before = scene_state([sword])
+    before.pop("objects")
+
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert_no_bone_near_the_blade(armature, sword)
+    after = scene_state([sword])
+    after.pop("objects")
+    assert after == before
+    assert "'Sword' is held: a rigid prop, left out of the skeleton" in capfd.readouterr().out
+
+
+def test_a_helmet_and_a_bracer_on_one_arm_are_skinned_not_held(clean_scene, capfd):
+    """A helmet has a twin of itself across the mirror plane; a bracer on the
+    right forearm has none but lies on the body: both are skinned as the
+    body is, over several bones."""
+    body = add_biped()
+    helmet = add_shell("Helmet", lambda vertices: vertices[:, 2] > 0.86)
+    bracer = add_shell("Bracer", lambda vertices: (vertices[:, 0] < -0.2) & (vertices[:, 0] > -0.25))
+    select_only([body, helmet, bracer], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    skeleton = convert.read_skeleton(armature)
+    assert "held" not in capfd.readouterr().out
+    for garment in (helmet, bracer):
+        weights = group_weights(garment, skeleton.names)
+        np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
+        assert garment.parent == armature
+    bracer_bones = group_weights(bracer, skeleton.names).max(axis=0) > 0.1
+    assert bracer_bones.sum() >= 2 and bracer_bones[skeleton.names.index("forearm.R")]
+
+
+def test_the_rig_command_with_rigify_binds_the_sword_to_the_def_hand(clean_scene, tmp_path, capsys):
+    """Every mesh of the file is taken; the sword goes to the generated
+    rig's deform bone of the hand."""
+    add_biped(), add_sword()
+    source, out = tmp_path / "knight.blend", tmp_path / "out"
+    scene_io.save_scene(source)
+    capsys.readouterr()
+
+    code = main(["rig", str(source), "--out", str(out), "--rigify", "--quiet"])
+
+    assert code == 0
+    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    assert item["meshes"] == ["Biped"] and item["rigify"]
+    assert "'Sword' held: bound wholly to bone 'DEF-hand.R' (a rigid prop, left out of the skeleton)" \
+        in item["notes"]
+    scene_io.load_scene(out / "knight.blend")
+    armature, sword = bpy.data.objects[item["armature"]], bpy.data.objects["Sword"]
+    assert_no_bone_near_the_blade(armature, sword)
+    assert_bound_wholly_to(sword, armature, "DEF-hand.R", turn_fk_hand)
+
+
+def test_the_rig_command_replacing_a_posed_rig_takes_the_sword_from_its_bone_where_it_is_at_rest(
+        clean_scene, tmp_path, capsys):
+    """KayKit's way: the file's armature posed (the right arm lowered), the
+    sword parented to the hand's bone. ``--replace`` unbinds the body, which
+    takes its rest shape, so the sword is taken off its bone where it is at
+    rest: in the rest hand, bound to the new hand bone. Before, it stayed
+    where the pose held it, 0.14 from the body at rest, and was left out as
+    a prop nothing holds."""
+    character = generate_character(BIPED_SEED, "biped")
+    body, sword = add_biped(), add_sword()
+    old_rig = build_armature(character.skeleton, "Rig", bpy.context)
+    bind(body, old_rig)
+    parent_to_bone(sword, old_rig, "hand.R")
+    pose_bone_turned(old_rig, "upper_arm.R", 60.0)
+    assert np.abs(evaluated_world_vertices(sword) - box_mesh(SWORD_LOW, SWORD_HIGH, 0.02).vertices).max() > 0.2
+    source, out = tmp_path / "posed.blend", tmp_path / "out"
+    scene_io.save_scene(source)
+    capsys.readouterr()
+
+    code = main(["rig", str(source), "--out", str(out), "--replace", "--quiet"])
+
+    assert code == 0
+    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    assert item["meshes"] == ["Biped"] and item["replaced"] == ["Rig"]
+    assert "'Sword' held: bound wholly to bone 'hand.R' (a rigid prop, left out of the skeleton)" in item["notes"]
+    scene_io.load_scene(out / "posed.blend")
+    armature, sword = bpy.data.objects[item["armature"]], bpy.data.objects["Sword"]
+    np.testing.assert_allclose(evaluated_world_vertices(sword), box_mesh(SWORD_LOW, SWORD_HIGH, 0.02).vertices,
+                               atol=1e-5)
+    assert_bound_wholly_to(sword, armature, "hand.R")
