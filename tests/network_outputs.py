@@ -35,6 +35,7 @@ from autorig_addon.core.rigging import predict as rig_predict
 from autorig_addon.core.rigging.connectivity import bone_probabilities, root_scores
 from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth
 from autorig_addon.core.rigging.networks import joints, landmarks
+from autorig_addon.core.rigging.orientation import up_probabilities
 from autorig_addon.core.rigging.tree_features import candidate_pairs, pair_features, root_features
 from autorig_addon.core.skinning.learned import predict as skin_predict
 from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
@@ -72,7 +73,8 @@ def skin_outputs() -> dict:
 def rig_outputs() -> dict:
     """The landmark network's ``landmarks.points`` (15, 3) and
     ``landmarks.kind_logits`` (1, 3), the joint network's ``joints.offsets``
-    (n, 3) and ``joints.attention`` (n,), then ``bones.probabilities`` and ``root.scores`` on the character's
+    (n, 3) and ``joints.attention`` (n,), the upright network's ``upright.probabilities`` (4,), then
+    ``bones.probabilities`` and ``root.scores`` on the character's
     own joints (fixed inputs: joints a mean shift finds can move by more than
     the tolerance with the number of BLAS threads, which the predicted
     skeleton's record covers)."""
@@ -93,6 +95,7 @@ def rig_outputs() -> dict:
         "joints.attention": sigmoid(logits).astype(np.float32),
         "bones.probabilities": bone_probabilities(pair_features(found, pairs, solid, mirror)).astype(np.float32),
         "root.scores": root_scores(root_features(found, solid)).astype(np.float32),
+        "upright.probabilities": up_probabilities(mesh.vertices, mesh.triangles).astype(np.float32),
     }
 
 

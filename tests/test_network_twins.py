@@ -19,6 +19,7 @@ from autorig_addon.core.rigging.tree_features import (
     pair_features,
     root_features,
 )
+from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT, candidate_features, surface_points
 from autorig_addon.core.skinning.learned import predict
 from autorig_addon.core.skinning.learned.features import PRIOR_FLOOR, skin_graph
 from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
@@ -88,7 +89,8 @@ def random_inputs(name, seed):
         return skin_graph(*random_skin_inputs(seed, 40 + bone_count, bone_count))
     if name in ("joints", "landmarks"):
         return random_joint_graph(seed)
-    return rng.normal(size=(300, PAIR_FEATURES if name == "bones" else ROOT_FEATURES)).astype(np.float32)
+    columns = {"bones": PAIR_FEATURES, "root": ROOT_FEATURES, "upright": UP_FEATURE_COUNT}[name]
+    return rng.normal(size=(300, columns)).astype(np.float32)
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +107,9 @@ def procedural_inputs():
     graph = joint_graph(sample.mesh, solid)
     inputs.update(joints=graph, landmarks=graph,
                   bones=pair_features(joints, candidate_pairs(joints), solid, np.full(len(joints), -1)),
-                  root=root_features(joints, solid))
+                  root=root_features(joints, solid),
+                  upright=candidate_features(*surface_points(sample.mesh.vertices, sample.mesh.triangles)).astype(
+                      np.float32))
     return inputs
 
 

@@ -410,3 +410,23 @@ def test_esc_stops_the_worker_and_leaves_nothing(biped, monkeypatch):
     assert operator.reports == [({"WARNING"}, "Rigging cancelled; nothing was changed.")]
     assert scene_state([biped]) == before and len(bpy.data.armatures) == 0
     assert context.window_manager.calls[-2:] == [("remove_timer", "timer"), ("end",)]
+
+
+def test_a_character_lying_on_its_back_by_its_object_rotation_is_rigged_standing_in_its_own_frame(clean_scene):
+    # As a Y-up import can leave it: the mesh upright in its own data, the object turned -90 degrees about X, so
+    # in the scene the character lies on its back with its head toward +Y.
+    obj = add_biped()
+    obj.rotation_euler = (-np.pi / 2, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    select_only([obj], active=obj)
+
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+
+    (armature,) = armatures()
+    skeleton = convert.read_skeleton(armature)
+    joint = {name: skeleton.joints[k] for k, name in enumerate(skeleton.names)}
+    up, left = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])  # the character's own, in the scene
+    assert (joint["head"] - joint["spine"]) @ up > 0.2
+    assert (joint["thigh.L"] - joint["thigh.R"]) @ left > 0.05
+    assert (joint["upper_arm.L"] - joint["upper_arm.R"]) @ left > 0.1
+    assert outside_box(skeleton.joints, convert.read_mesh([obj]).vertices).max() == 0.0

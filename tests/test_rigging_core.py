@@ -561,11 +561,9 @@ def test_a_mesh_with_nan_vertices_is_refused(biped):
         predict.predict_skeleton(Mesh(vertices, biped[0].triangles))
 
 
-#: A character facing +X is turned a quarter like one facing -X (the
-#: mirror plane does not say which way it faces), so the network sees it
-#: from behind and its .L bones lie on its right: the documented limit
-#: (docs/rigging.md). Its skeleton is still well formed and symmetric; the
-#: tests of positions and sides use the character facing -X.
+#: A character facing +X or -X is turned a quarter one way (the mirror
+#: plane does not say which way it faces: the one that brings +Y to +X), so
+#: one facing -X then faces +Y and is turned on by its feet.
 FACING_PLUS_X, FACING_MINUS_X = 1, -1
 
 
@@ -584,11 +582,11 @@ def test_a_character_facing_x_is_noted_and_turned_for_the_prediction(direction):
     _, mesh, votes, skeleton = turned_prediction(direction)
     assert votes.notes[0] == ("The character faces +-X; it was turned a quarter for the prediction (its mirror "
                               "plane is x = 0 of its own space).")
-    # The quarter turn that finds the mirror plane turns a character facing +X to face +Y; its feet tell, and
+    # The quarter turn that finds the mirror plane turns a character facing -X to face +Y; its feet tell, and
     # it is turned on to face -Y.
     half_turn = ("The character faces away from -Y (turned, it reads as a biped); it was turned half a turn for the "
                  "prediction, so its .L bones lie on its own left.")
-    assert votes.notes[1:] == ((half_turn,) if direction == FACING_PLUS_X else ())
+    assert votes.notes[1:] == ((half_turn,) if direction == FACING_MINUS_X else ())
     assert votes.symmetric
     assert_well_formed(skeleton, mesh)
 
@@ -610,14 +608,83 @@ def test_the_names_of_a_turned_character_are_on_its_own_sides():
             assert offset @ left > 0, name
 
 
-#: Lying on its side the biped's mirror errors (share of the largest side;
-#: across x, y, z of the normalised proxy) measured 0.0489, 0.0291 and 0.0:
-#: the horizontal plane mirrors it clearly best, so it is refused.
-def test_a_character_lying_on_its_side_is_refused():
+def rotation_about(axis, degrees):
+    """The rotation by ``degrees`` about the unit ``axis`` (3,) (right-hand rule)."""
+    axis = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
+    angle = np.radians(degrees)
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * cross + (1.0 - np.cos(angle)) * cross @ cross
+
+
+#: Ways a user's file may hold a character: the rotation from the generator's
+#: upright frame (+Z up, facing -Y) to the file's.
+NOT_UPRIGHT = {
+    "on its back": rotation_about([1, 0, 0], -90),  # a Y-up import: its head toward +Y
+    "on its front": rotation_about([1, 0, 0], 90),
+    "on its side": rotation_about([0, 1, 0], 90),
+    "upside down": rotation_about([1, 0, 0], 180),
+    "turned 30 degrees": rotation_about([0, 0, 1], 30),
+    "on its back, turned 30 degrees": rotation_about([1, 0, 0], -90) @ rotation_about([0, 0, 1], 30),
+}
+
+
+def assert_standing_in_its_own_frame(skeleton, rotation, head, hips, left_pairs):
+    """The skeleton's ``head`` joint is above its ``hips`` and each left bone
+    of ``left_pairs`` on the character's own left, in the frame the
+    character stands in (``rotation`` from upright to the file)."""
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    up, left = rotation @ [0.0, 0.0, 1.0], rotation @ [1.0, 0.0, 0.0]
+    rise = (skeleton.joints[names[head]] - skeleton.joints[names[hips]]) @ up
+    assert rise > 0.1 * WORLD_SCALE, rise
+    for role in left_pairs:
+        across = (skeleton.joints[names[role + LEFT_SUFFIX]] - skeleton.joints[names[role + RIGHT_SUFFIX]]) @ left
+        assert across > 0.02 * WORLD_SCALE, role
+
+
+@pytest.mark.parametrize("how", list(NOT_UPRIGHT))
+def test_a_biped_not_upright_is_rigged_standing_in_its_own_frame(how):
+    rotation = NOT_UPRIGHT[how]
     character = generate_character(BIPED_SEED, "biped")
-    mesh = Mesh(placed(character.mesh.vertices, quarter_turn(1)), character.mesh.triangles)
-    with pytest.raises(InputError, match="lie on its side"):
-        predict.predict_votes(mesh)
+    mesh = Mesh(placed(character.mesh.vertices, rotation), character.mesh.triangles)
+    votes = predict.predict_votes(mesh)
+    assert votes.landmarks.kind == "biped"
+    skeleton = predict.skeleton_from_votes(votes)
+    assert_standing_in_its_own_frame(skeleton, rotation, "head", "spine", ("upper_arm", "thigh", "foot"))
+    assert_well_formed(skeleton, mesh)
+
+
+@pytest.mark.parametrize("how", ["on its back", "on its front", "upside down", "on its side"])
+def test_a_quadruped_not_upright_is_rigged_standing_in_its_own_frame(how):
+    rotation = NOT_UPRIGHT[how]
+    character = generate_character(QUADRUPED_SEED, "quadruped")
+    mesh = Mesh(placed(character.mesh.vertices, rotation), character.mesh.triangles)
+    votes = predict.predict_votes(mesh)
+    assert votes.landmarks.kind == "quadruped"
+    skeleton = predict.skeleton_from_votes(votes)
+    assert_standing_in_its_own_frame(skeleton, rotation, "head", "thigh.L", ("thigh", "front_thigh"))
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    forward = rotation @ [0.0, -1.0, 0.0]
+    assert (skeleton.joints[names["head"]] - skeleton.joints[names["spine"]]) @ forward > 0
+
+
+def test_the_note_says_how_the_character_was_found_and_turned():
+    character = generate_character(BIPED_SEED, "biped")
+    on_its_back = Mesh(placed(character.mesh.vertices, NOT_UPRIGHT["on its back"]), character.mesh.triangles)
+    assert predict.predict_votes(on_its_back).notes[0].startswith(
+        "The character is not upright (its up is +Y of its own space; stood up, it reads as a biped")
+    turned = Mesh(placed(character.mesh.vertices, NOT_UPRIGHT["turned 30 degrees"]), character.mesh.triangles)
+    assert predict.predict_votes(turned).notes[0] == (
+        "The character is turned 30 degrees about Z from facing -Y or +Y (its mirror plane was found at that "
+        "angle); it was turned back for the prediction.")
+
+
+def test_a_shape_lying_on_its_side_that_stands_up_no_way_as_a_body_is_refused():
+    # A flat L: mirror-symmetric across the horizontal plane alone, and no way of standing it up reads as a body.
+    long_arm = box_mesh([0.0, 0.0, -0.05], [2.0, 0.3, 0.05], 0.05)
+    short_arm = box_mesh([0.0, 0.3, -0.05], [0.3, 1.2, 0.05], 0.05)
+    flat_l = Mesh.concatenate([long_arm, short_arm])
+    with pytest.raises(InputError, match="seems to lie on its side"):
+        predict.predict_votes(Mesh(placed(flat_l.vertices), flat_l.triangles))
 
 
 def test_a_leaf_bone_is_cut_to_stay_inside_the_body():

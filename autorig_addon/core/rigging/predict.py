@@ -16,7 +16,8 @@
 
 The character is expected upright along +Z, facing -Y, its left at +X
 (Blender's front view). One facing +-X is recognised by its mirror plane and
-turned for the network; one lying on its side is refused with a message.
+turned for the network; so is one turned by any angle, lying or upside down
+(:mod:`.orientation`).
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from .connectivity import bone_probabilities, oriented_tree, root_scores, spanni
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
+from .orientation import stand_upright
 from .quality import skeleton_problems
 from .role_names import role_names
 from .standard_skeleton import (
@@ -55,9 +57,10 @@ from .standard_skeleton import (
     half_turned,
     landmark_warnings,
     predict_landmarks,
+    standard_confidence,
     standard_skeleton,
 )
-from .symmetry import CLEARLY_BETTER, SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
+from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
 
 #: Mean-shift bandwidth, share of the character's largest side: the level
@@ -87,6 +90,8 @@ STANDARD_KINDS = ("biped", "quadruped")
 #: Joints this close to the mirror plane, or to their twin's mirror image,
 #: are snapped (share of the bandwidth).
 SNAP_SHARE = 0.5
+#: Half a turn about the vertical axis.
+HALF_TURN = np.diag([-1.0, -1.0, 1.0])
 #: Fewest faces with an area a mesh needs: below this there is no shape to read.
 MIN_FACES = 16
 #: A face whose area is below this share of the squared diagonal of the
@@ -130,30 +135,6 @@ class JointVotes:
     proxy_vertices: np.ndarray | None = None
 
 
-def facing_turns(vertices: np.ndarray) -> int:
-    """Quarter turns that bring the character's mirror plane to x = 0.
-
-    The plane through the box centre with the smallest mirror error is the
-    character's, when that error is below :data:`CLEARLY_BETTER` times the
-    next smallest: across x the character faces -y (or +y) as expected;
-    across y it faces +-x and is turned a quarter; across z it lies on its
-    side and is refused. Otherwise (a human is nearly as symmetric front to
-    back as left to right) it is kept as it is.
-
-    Raises
-    ------
-    InputError when the character lies on its side.
-    """
-    errors = np.array([mirror_error(vertices, axis) for axis in range(3)])
-    best, runner_up = np.argsort(errors)[:2]
-    if errors[best] >= CLEARLY_BETTER * errors[runner_up]:
-        return 0
-    if best == 2:
-        raise InputError("The character seems to lie on its side (it is mirror-symmetric top to bottom, not left to "
-                         "right): stand it upright along +Z, facing -Y, and predict again.")
-    return 1 if best == 1 else 0
-
-
 def require_enough_faces(mesh: Mesh) -> None:
     """Refuse a mesh with fewer than :data:`MIN_FACES` faces with an area
     (:data:`FLAT_FACE_AREA_SHARE`): faces without one (a triangle with
@@ -185,7 +166,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
 
     Raises
     ------
-    InputError for a mesh with too few faces with an area, or lying on its side.
+    InputError for a mesh with too few faces with an area, or a lying character whose up cannot be told.
     """
     # Vertices in no face have no surface to read; the proxy would keep them.
     faceless = np.ones(mesh.vertex_count, dtype=bool)
@@ -199,19 +180,34 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     weights = shipped_weights(joint_network.SPEC).weights
     report(progress, 0.0, "Simplifying the mesh")
     proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
-    transform = normalisation_transform(proxy.vertices)
+    readings = {}
+
+    def read(rotation: np.ndarray) -> tuple:
+        """The transform, graph, solid, landmarks and half-turned landmarks of
+        the proxy turned by ``rotation``, each read once."""
+        key = np.round(rotation, 9).tobytes()
+        if key not in readings:
+            transform = framed_transform(proxy.vertices, rotation)
+            graph, solid, landmarks = _read_shape(proxy, transform, progress)
+            readings[key] = (transform, graph, solid, landmarks, predict_landmarks(half_turned(graph)))
+        return readings[key]
+
+    def standing_reading(rotation: np.ndarray) -> Landmarks:
+        """The landmarks of the proxy turned by ``rotation``, facing -Y or +Y,
+        whichever reads more surely as a biped or quadruped (the kind head
+        reads a character from behind less surely)."""
+        landmarks, turned = read(rotation)[3:]
+        return landmarks if standard_confidence(landmarks) >= standard_confidence(turned) else turned
+
     notes = [inward_faces_note(int(inward.sum()), "the skeleton prediction")] if inward.any() else []
-    turns = facing_turns(apply_transform(proxy.vertices, transform))
-    if turns:
-        transform = normalisation_transform(proxy.vertices, turns)
-        notes.append("The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 "
-                     "of its own space).")
-    graph, solid, landmarks = _read_shape(proxy, transform, progress)
-    if faces_backward(landmarks, graph.vertices, predict_landmarks(half_turned(graph))):
+    stance = stand_upright(proxy.vertices, proxy.triangles, standing_reading)
+    notes += stance.notes
+    rotation = stance.rotation
+    transform, graph, solid, landmarks, turned = read(rotation)
+    if faces_backward(landmarks, graph.vertices, turned):
         # Turned half a turn the character faces -y as the networks expect, its left at +x.
-        turns += 2
-        transform = normalisation_transform(proxy.vertices, turns)
-        graph, solid, landmarks = _read_shape(proxy, transform, progress)
+        rotation = HALF_TURN @ rotation
+        transform, graph, solid, landmarks = read(rotation)[:4]
         notes.append(f"The character faces away from -Y (turned, it reads as a {landmarks.kind}); it was turned half "
                      "a turn for the prediction, so its .L bones lie on its own left.")
     report(progress, 0.7, "Running the joint network")
@@ -220,6 +216,14 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices)
+
+
+def framed_transform(vertices: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """(4, 4) from the mesh's space to the normalised frame of ``vertices``
+    turned by ``rotation`` (3, 3) first (:func:`.orientation.stand_upright`)."""
+    turn = np.eye(4)
+    turn[:3, :3] = rotation
+    return normalisation_transform(vertices @ rotation.T) @ turn
 
 
 def _read_shape(proxy: Mesh, transform: np.ndarray, progress) -> tuple:

@@ -152,7 +152,7 @@ def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks
     landmark network reads it much more surely as a biped or quadruped when
     turned half a turn (``turned``, its landmarks on :func:`half_turned`), or
     a biped's feet reach behind its ankles. Only a clear case counts."""
-    if turned is not None and _standard_confidence(turned) >= _standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
+    if turned is not None and standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
         return True
     points = landmarks.points
     if landmarks.kind != BIPED:
@@ -169,7 +169,8 @@ def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks
     return behind > BACKWARD_FEET_RATIO * ahead and behind > 0.0
 
 
-def _standard_confidence(landmarks: Landmarks) -> float:
+def standard_confidence(landmarks: Landmarks) -> float:
+    """The probability of the likelier of the kinds with a standard skeleton."""
     return max(landmarks.kind_probabilities[BIPED], landmarks.kind_probabilities[QUADRUPED])
 
 

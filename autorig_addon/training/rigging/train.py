@@ -65,6 +65,7 @@ from ..runs import (
 )
 from .landmarks import train_landmark_network
 from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
+from .upright import copies_per_character, upright_data
 
 #: Weight of the attention loss beside the offset loss.
 ATTENTION_LOSS_WEIGHT = 0.5
@@ -85,7 +86,7 @@ JITTER_COPIES = 4
 SCORED_PER_FAMILY = 2
 #: The held-out score each network's epoch is chosen by (lower is better).
 SCORE_NAMES = {"joints": "cd_j2j", "landmarks": "landmark_error", "bones": "cross_entropy",
-               "root": "cross_entropy"}
+               "root": "cross_entropy", "upright": "cross_entropy"}
 #: Networks trained full batch on a fixed family sample of characters.
 FULL_BATCH_NETWORKS = ("bones", "root")
 #: Epochs between progress lines (and history entries) of the full-batch networks.
@@ -220,8 +221,14 @@ def connectivity_accuracy(network: str, weights: dict, data: dict) -> float:
 def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, record: FitRecord) -> dict:
     """Train ``bones`` or ``root`` (torch seeded by the caller); returns the kept weights."""
     rng = np.random.default_rng(record.seed)
+    return train_full_batch(spec, connectivity_data(train, rng), connectivity_data(holdout, rng), record)
+
+
+def train_full_batch(spec: NetworkSpec, train_data: dict, held_data: dict, record: FitRecord) -> dict:
+    """Train a network that scores rows (``bones``: pairs; ``root`` and
+    ``upright``: candidates, one softmax per copy) full batch on data in
+    :func:`connectivity_data`'s layout; returns the kept weights."""
     module = NetworkModule(spec).to(record.device)
-    train_data, held_data = connectivity_data(train, rng), connectivity_data(holdout, rng)
     features = train_data["pair_features" if spec.name == "bones" else "root_features"]
     module.standardise_from(torch.as_tensor(features, device=record.device))
 
@@ -238,7 +245,7 @@ def train_connectivity_network(spec: NetworkSpec, train: list, holdout: list, re
 def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None,
                      epochs: Optional[int] = None, learning_rate: Optional[float] = None, seed: int = 0,
                      device: str = "auto", output: Optional[Path] = None, procedural: int = 0) -> FitRecord:
-    """Train ``network`` (``joints``, ``bones`` or ``root``) and write its weights; returns the record.
+    """Train ``network`` (any of ``core.rigging.networks.NETWORK_NAMES``) and write its weights; returns the record.
 
     ``procedural`` adds the procedural characters of seeds ``0 .. procedural - 1``
     (exact skeletons) as training characters; they are never held out, so
@@ -249,6 +256,10 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
                        score_name=SCORE_NAMES.get(network, "cross_entropy"))
     folder = Path(examples_dir or default_examples_dir(seed))
     samples = training_samples(Path(sample_dir), purpose=PURPOSE_SKELETON)
+    if network == "upright":
+        # The upright network reads the samples' shapes alone: no examples (graphs, stretched variants) needed.
+        write_weights(spec, _train_upright(spec, samples, record), record, output)
+        return record
     examples = build_examples(samples, folder, seed)
     names = sorted(examples)
     held_out = held_out_names(names)
@@ -274,3 +285,21 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
         weights = train_connectivity_network(spec, train, holdout, record)
     write_weights(spec, weights, record, output)
     return record
+
+
+def _train_upright(spec: NetworkSpec, samples: list, record: FitRecord) -> dict:
+    """The upright network on every training character but the held-out
+    ones (every HOLDOUT_EVERY-th), families weighed alike
+    (:func:`.upright.copies_per_character`); scored on at most
+    SCORED_PER_FAMILY held-out characters per family, one copy each."""
+    by_name = {sample.name: sample for sample in samples}
+    names = sorted(by_name)
+    held_out = held_out_names(names)
+    families = character_families(names)
+    trained = [name for name in names if name not in held_out]
+    held = family_sample(sorted(held_out), families, SCORED_PER_FAMILY)
+    rng = np.random.default_rng(record.seed)
+    train_data = upright_data([by_name[name] for name in trained], copies_per_character(trained, families), rng)
+    held_data = upright_data([by_name[name] for name in held], [1] * len(held), rng)
+    record.details.update(train_characters=len(trained), train_copies=len(train_data["roots"]), holdout=held)
+    return train_full_batch(spec, train_data, held_data, record)
