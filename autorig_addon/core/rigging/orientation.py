@@ -133,8 +133,14 @@ def best_mirror_plane(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     spread = np.cov((points - points.mean(axis=0)).T)
     candidates = np.concatenate([np.linalg.eigh(spread)[1].T, np.eye(3)])
     errors = np.array([error(normal) for normal in candidates])
-    normal = _refined(candidates[int(np.argmin(errors))], error)
-    best = error(normal)
+    best_candidate = int(np.argmin(errors))
+    if best_candidate >= 3:
+        # A mesh axis mirrors best, as it does an artist's character modelled axis-aligned: the plane is snapped
+        # to it anyway, so refining (most of this function's time) would change nothing.
+        normal, best = candidates[best_candidate], float(errors[best_candidate])
+    else:
+        normal = _refined(candidates[best_candidate], error)
+        best = error(normal)
     across, across_normal = _best_across(normal, error)
     if across < best:
         # The coarse grid fell in the wrong basin; the plane across it is the mirror plane.
