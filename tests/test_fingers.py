@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging.fingers import NOT_SEPARABLE_NOTE, hand_fingers
+from autorig_addon.core.rigging.fingers import FINGER_NAMES, NOT_SEPARABLE_NOTE, hand_fingers
+from autorig_addon.core.rigging.metarig import FINGER_RIG, PALM_RIG, PALM_START, finger_bones
 from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes, template_notes
 from autorig_addon.core.skeleton.name_presets import PRESETS, preset_names
 from autorig_addon.core.types import Mesh
@@ -134,3 +135,23 @@ def test_finger_names_go_through_every_preset_and_back(fingered_votes):
     assert {"mixamorig:LeftHandIndex1", "mixamorig:RightHandPinky3", "mixamorig:LeftHandThumb2"} <= set(mixamo)
     assert {"leftIndexProximal", "leftThumbMetacarpal"} <= set(preset_names(names, "vrm")[0])
     assert "index_01_l" in preset_names(names, "unreal")[0]
+
+
+def test_rigify_palm_and_finger_bones_sit_on_the_knuckles_and_none_without_fingers(fingered_votes):
+    skeleton = skeleton_from_votes(fingered_votes, template="biped")
+    added = {bone.name: bone for bone in finger_bones(skeleton)}
+    index = {name: k for k, name in enumerate(skeleton.names)}
+    assert len(added) == 2 * (4 + 15)
+    for side, sign in ((".L", 1.0), (".R", -1.0)):
+        wrist = skeleton.joints[index["hand" + side]]
+        for palm, finger in zip(("palm.01", "palm.02", "palm.03", "palm.04"), FINGER_NAMES[1:]):
+            bone, knuckle = added[palm + side], skeleton.joints[index[f"{finger}.01{side}"]]
+            assert bone.parent == "hand" + side and bone.up == ("x", sign)
+            np.testing.assert_allclose(bone.tail, knuckle)
+            np.testing.assert_allclose(bone.head, wrist + PALM_START * (knuckle - wrist))
+            assert added[f"{finger}.01{side}"].parent == palm + side
+        assert added["palm.01" + side].rig_type == PALM_RIG and added["palm.02" + side].rig_type == ""
+        assert added["thumb.01" + side].parent == "palm.01" + side and added["thumb.01" + side].up == ("z", -1.0)
+        assert added["f_index.01" + side].rig_type == FINGER_RIG and not added["f_index.01" + side].connected
+        assert added["f_index.02" + side].parent == "f_index.01" + side and added["f_index.03" + side].connected
+    assert finger_bones(skeleton_from_votes(fingered_votes, template="biped", fingers=False)) == ()
