@@ -215,3 +215,25 @@ def test_a_poor_skeleton_fails_with_the_reason_unless_kept(clean_scene, tmp_path
     (item,) = json.loads(stdout)["succeeded"]
     assert item["problems"] and all("outside the body" in problem for problem in item["problems"])
     assert any(note.startswith("poor result kept: ") for note in item["notes"])
+
+
+def test_no_fingers_gives_the_22_bones_on_a_biped_with_fingers_and_fingers_the_52(clean_scene, tmp_path, capsys):
+    from test_fingers import procedural_biped_with_box_fingers
+
+    source = tmp_path / "hero.blend"
+    reset_scene()
+    mesh = procedural_biped_with_box_fingers()
+    mesh_object("Biped", mesh.vertices, mesh.triangles)
+    bpy.context.view_layer.update()
+    scene_io.save_scene(source)
+    counts = {}
+    for switch in ("--no-fingers", "--fingers"):
+        out = tmp_path / f"out{switch}.blend"
+        code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--template", "biped", switch,
+                                    "--skin", "none", "--quiet"], capsys)
+        assert code == 0
+        (item,) = json.loads(stdout)["succeeded"]
+        armature = next(obj for obj in objects_of(out).values() if obj.type == "ARMATURE")
+        counts[switch] = (item["bones"], len(armature.data.bones),
+                          sum(bone.name.startswith(("thumb", "f_")) for bone in armature.data.bones))
+    assert counts == {"--no-fingers": (22, 22, 0), "--fingers": (52, 52, 30)}

@@ -430,3 +430,38 @@ def test_a_character_lying_on_its_back_by_its_object_rotation_is_rigged_standing
     assert (joint["thigh.L"] - joint["thigh.R"]) @ left > 0.05
     assert (joint["upper_arm.L"] - joint["upper_arm.R"]) @ left > 0.1
     assert outside_box(skeleton.joints, convert.read_mesh([obj]).vertices).max() == 0.0
+
+
+def add_fingered_biped(name="Biped"):
+    """The procedural biped with four box fingers and a thumb on each hand (``test_fingers``)."""
+    from test_fingers import procedural_biped_with_box_fingers
+
+    mesh = procedural_biped_with_box_fingers()
+    obj = mesh_object(name, mesh.vertices, mesh.triangles)
+    bpy.context.view_layer.update()
+    select_only([obj], active=obj)
+    return obj
+
+
+def test_the_fingers_switch_off_gives_the_22_bones_and_on_weighted_finger_bones(clean_scene):
+    obj = add_fingered_biped()
+    assert bpy.ops.autorig.predict_skeleton(rig_template="BIPED", rig_fingers=False) == {"FINISHED"}
+    (armature,) = armatures()
+    assert len(armature.data.bones) == 22
+    assert not any(bone.name.startswith(("thumb", "f_")) for bone in armature.data.bones)
+    bpy.data.objects.remove(armature)
+    bpy.context.view_layer.update()
+    select_only([obj], active=obj)
+
+    assert bpy.ops.autorig.auto_rig(rig_template="BIPED", rig_fingers=True, skin_method="GEOMETRIC") == {"FINISHED"}
+    (armature,) = armatures()
+    names = [bone.name for bone in armature.data.bones]
+    fingers = [name for name in names if name.startswith(("thumb", "f_"))]
+    assert len(names) == 22 + 30 and len(fingers) == 30
+    assert all(armature.data.bones[name].parent.name.startswith(("hand", "thumb", "f_")) for name in fingers)
+    # The fingers carry weight: the box fingers' vertices (the mesh's last 2 x 5 x 8) past the palm follow them
+    # (the mitten hand under them does too).
+    weights = group_weights(obj, fingers).sum(axis=1)
+    assert (weights[-80:] > 0.5).sum() >= 30, np.sort(weights[-80:])
+    for side in (".L", ".R"):
+        assert sum(group.name in fingers and group.name.endswith(side) for group in obj.vertex_groups) >= 5

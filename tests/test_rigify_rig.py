@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 from mathutils import Euler, Matrix, Vector
 
+from autorig_addon.blender import convert
 from autorig_addon.blender.armature_builder import build_armature
 from autorig_addon.blender.jobs.rig import RigSettings, plan_rig, rig_steps, run_steps
 from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes
 from autorig_addon.core.skinning.options import SkinningOptions
 from autorig_addon.core.types import Skeleton
 from blender_fixtures import evaluated_world_vertices, mesh_object, select_only
@@ -173,3 +175,56 @@ def test_generate_rigify_rig_from_the_operator_is_one_undo_step(clean_scene):
     bpy.ops.ed.undo()
     assert sorted(o.name for o in bpy.data.objects if o.type == "ARMATURE") == []
     assert len(bpy.data.objects["Biped"].modifiers) == 0 and len(bpy.data.objects["Biped"].vertex_groups) == 0
+
+
+FINGERS = ("thumb", "f_index", "f_middle", "f_ring", "f_pinky")
+
+
+def test_a_biped_with_fingers_gets_rigify_fingers_on_its_knuckles_that_curl_toward_the_palm(clean_scene):
+    from test_fingers import procedural_biped_with_box_fingers
+
+    mesh = procedural_biped_with_box_fingers()
+    obj = mesh_object("Biped", mesh.vertices, mesh.triangles)
+    bpy.context.view_layer.update()
+    # Our prediction from the mesh as Blender holds it (single precision), as Auto-Rig reads it.
+    predicted = skeleton_from_votes(predict_votes(convert.read_mesh([obj])), template="biped")
+    joints = dict(zip(predicted.names, predicted.joints))
+    tails = dict(zip(predicted.names, predicted.tails))
+    select_only([obj], active=obj)
+    plan = plan_rig([obj], bpy.context.evaluated_depsgraph_get(), "Biped", RigSettings(template="biped"),
+                    skin=SkinSettings(SkinningOptions(method="geometric")), rigify=True)
+    rig = run_steps(rig_steps(bpy.context, plan, remember=False)).armature
+    metarig = bpy.data.objects["Biped_rig_metarig"]
+    assert metarig.pose.bones["palm.01.L"].rigify_type == "limbs.super_palm"
+    assert metarig.pose.bones["f_index.01.L"].rigify_type == "limbs.super_finger"
+    assert metarig.data.bones["f_index.02.L"].use_connect and not metarig.data.bones["f_index.01.L"].use_connect
+    deforming = {bone.name for bone in rig.data.bones if bone.use_deform}
+    for side in (".L", ".R"):
+        assert {f"DEF-palm.{number:02d}{side}" for number in (1, 2, 3, 4)} <= deforming
+        assert {f"DEF-{finger}.{joint:02d}{side}" for finger in FINGERS for joint in (1, 2, 3)} <= deforming
+    # Rigify splits each DEF- finger bone in two; its first part starts on our knuckle.
+    np.testing.assert_allclose(world_head(rig, "DEF-f_index.01.L"), joints["f_index.01.L"], atol=1e-3)
+    groups = {group.name for group in obj.vertex_groups}
+    assert groups <= deforming
+    for side in (".L", ".R"):  # the fingers carry weight
+        assert len({name for name in groups if name.startswith(("DEF-f_", "DEF-thumb")) and name.endswith(side)}) >= 5
+
+    wrist = world_head(rig, "DEF-hand.L")
+    tail_before = np.array(rig.matrix_world @ rig.pose.bones["DEF-f_index.03.L"].tail)
+    rest = evaluated_world_vertices(obj)
+    control = rig.pose.bones["f_index.01.L"]  # the finger's first FK control (its master: f_index.01_master.L)
+    control.rotation_mode = "XYZ"
+    control.rotation_euler = Euler((np.radians(45.0), 0.0, 0.0))
+    bpy.context.view_layer.update()
+    np.testing.assert_allclose(world_head(rig, "DEF-hand.L"), wrist, atol=1e-6)
+    tail_after = np.array(rig.matrix_world @ rig.pose.bones["DEF-f_index.03.L"].tail)
+    # The finger swings about its knuckle (0.4 of its length for 45 degrees), toward the palm: down.
+    length = np.linalg.norm(tails["f_index.03.L"] - joints["f_index.01.L"])
+    assert np.linalg.norm(tail_after - tail_before) > 0.4 * length
+    assert tail_after[2] < tail_before[2] - 0.2 * length
+    moved = np.linalg.norm(evaluated_world_vertices(obj) - rest, axis=1)
+    near_tip = np.linalg.norm(rest - tails["f_index.03.L"], axis=1) < 0.3 * length
+    near_middle_tip = np.linalg.norm(rest - tails["f_middle.03.L"], axis=1) < 0.3 * length
+    assert near_tip.sum() >= 4 and np.median(moved[near_tip]) > 0.3 * length
+    assert np.median(moved[near_middle_tip]) < 0.05 * length
+    assert moved[rest[:, 0] < -0.1].max() < 1e-6  # the right side stays

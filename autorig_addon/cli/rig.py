@@ -92,7 +92,8 @@ def run(args: argparse.Namespace) -> int:
     from ..blender.jobs.skin import SkinSettings
     from ..core.skinning.options import SkinningOptions
 
-    settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry, args.template, args.names)
+    settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry, args.template, args.names,
+                           args.fingers)
     skin = None if args.skin == NO_SKIN else SkinSettings(SkinningOptions(method=args.skin))
 
     def process(input_path, output_path, progress):

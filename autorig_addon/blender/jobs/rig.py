@@ -40,6 +40,7 @@ from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
 from ...core.rigging.predict import (
+    DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
     JointVotes,
     chosen_template,
@@ -105,6 +106,7 @@ class RigSettings:
     symmetry : bool or None, mirror votes and pair joints when the shape is left-right symmetric
     template : str or None, ``auto``, ``biped``, ``quadruped`` or ``free-form``
     names : str or None, a bone-name preset of ``core.skeleton.name_presets.PRESETS``
+    fingers : bool or None, give a standard biped fingers when its hands have separable ones
     """
 
     bandwidth: float | None = None
@@ -112,6 +114,7 @@ class RigSettings:
     symmetry: bool | None = None
     template: str | None = None
     names: str | None = None
+    fingers: bool | None = None
 
     def keywords(self) -> dict:
         """The keyword arguments of ``skeleton_from_votes`` that were given."""
@@ -393,9 +396,10 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     try:
         armature.show_in_front = True  # the bones are inside the body
         template = plan.settings.template or DEFAULT_TEMPLATE
+        fingers = DEFAULT_FINGERS if plan.settings.fingers is None else plan.settings.fingers
         naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
-        notes = (*plan.notes, *votes.notes, *template_notes(votes, template), *((naming,) if naming else ()),
-                 *(f"poor result kept: {problem}" for problem in problems))
+        notes = (*plan.notes, *votes.notes, *template_notes(votes, template, skeleton, fingers),
+                 *((naming,) if naming else ()), *(f"poor result kept: {problem}" for problem in problems))
         target = armature
         rig = None
         if plan.rigify:

@@ -148,6 +148,10 @@ class VIEW3D_PT_autorig_rig(_AutoRigSubPanel, bpy.types.Panel):
             column.label(text="Select the character's mesh(es)", icon="INFO")
 
         layout.prop(settings, "rig_template")
+        fingers = layout.row()
+        # Only a standard biped has fingers.
+        fingers.active = settings.rig_template in ("AUTO", "BIPED")
+        fingers.prop(settings, "rig_fingers")
         layout.prop(settings, "rig_names")
         column = layout.column(align=True)
         detail = column.column(align=True)

@@ -20,15 +20,31 @@ control rig:
 
 The breast and pelvis helpers are left out: they deform the chest and hips
 only in Rigify's own proportions. Positions are in the skeleton's space.
+
+A biped with fingers (:mod:`.fingers`) gets, as Rigify's full *Human*
+metarig has them and the basic one has not, :func:`finger_bones`: per
+side ``palm.01`` to ``palm.04`` (one per finger but the thumb, index
+first) parented to ``hand``, each from :data:`PALM_START` of the way from
+the wrist to its finger's knuckle to the knuckle, ``limbs.super_palm`` on
+``palm.01``; ``thumb.01`` and ``f_index.01`` parented to ``palm.01``,
+``f_middle.01`` to ``palm.02``, ``f_ring.01`` to ``palm.03``,
+``f_pinky.01`` to ``palm.04``, ``.02`` and ``.03`` connected to the bone
+before, ``limbs.super_finger`` on each ``.01``. Each bone's roll comes from
+the hand's axes as the Human metarig has them: a palm's and a finger's Z
+axis along the hand's X axis (toward the palm; mirrored on the right), the
+thumb's Z axis against the hand's Z axis.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names
 from ..types import Skeleton
+from .fingers import FINGER_BONES, FINGER_NAMES, finger_bone_names
 from .standard_skeleton import BIPED, QUADRUPED
 
 #: Rigify's metarig of each kind (the operator ``object.armature_<name>_metarig_add``).
@@ -46,6 +62,45 @@ LIMB_BONES = {
 #: shares of the foot's length (ankle to ball, seen from above): the
 #: metarig's 0.04 and 0.03 for a 0.13 foot.
 HEEL_HALF_WIDTH, HEEL_BEHIND = 0.3, 0.25
+#: A palm bone starts this share of the way from the wrist to its finger's
+#: knuckle (the Human metarig's palm bones: 0.36 to 0.38).
+PALM_START = 0.35
+#: Rigify's rig types of the palm (on ``palm.01``) and of each finger (on its ``.01``).
+PALM_RIG, FINGER_RIG = "limbs.super_palm", "limbs.super_finger"
+#: Rigify parameters of each finger's ``.01`` bone. The Human metarig's
+#: fingers are curled, so Rigify's automatic axis (the curl's plane) finds
+#: the bend; a found finger may be straight or bent sideways, so the curl is
+#: about the X axis that :attr:`MetarigBone.up` gives (toward the palm:
+#: Rigify's ``X``, the automatic axis' own sign). IK location as the Human
+#: metarig's.
+FINGER_PARAMETERS = (("primary_rotation_axis", "X"), ("ik_local_location", False))
+#: Rigify's bone collections for fingers (the Human metarig's): the controls, and the finger tweaks.
+FINGER_COLLECTION, FINGER_DETAIL_COLLECTION = "Fingers", "Fingers (Detail)"
+#: Rotation mode of the palm bones (the Human metarig's).
+PALM_ROTATION_MODE = "YXZ"
+
+
+@dataclass(frozen=True)
+class MetarigBone:
+    """A bone added to Rigify's basic metarig (:func:`finger_bones`).
+
+    Attributes
+    ----------
+    name, parent : str
+    head, tail : (3,) float64, in the skeleton's space
+    connected : bool, its head on its parent's tail, connected
+    rig_type : str, Rigify's rig type ("" for none)
+    up : (axis, sign): its Z axis points along ``sign`` times the placed
+        hand's ``axis`` (``"x"`` or ``"z"``) of the same side
+    """
+
+    name: str
+    parent: str
+    head: np.ndarray
+    tail: np.ndarray
+    connected: bool
+    rig_type: str
+    up: tuple
 
 
 def skeleton_kind(names) -> str:
@@ -133,3 +188,40 @@ def metarig_placement(skeleton: Skeleton) -> tuple[str, dict, tuple]:
     else:
         removed += QUADRUPED_TAIL
     return kind, placement, tuple(removed)
+
+
+def finger_bones(skeleton: Skeleton) -> tuple:
+    """The palm and finger bones to add to Rigify's basic human metarig for
+    ``skeleton``'s fingers (see the module docstring), parents first; empty
+    without fingers.
+
+    Returns
+    -------
+    tuple of MetarigBone
+    """
+    names = preset_names(skeleton.names, DEFAULT_PRESET)[0]
+    index = {name: k for k, name in enumerate(names)}
+    added = []
+    for side, sign in ((".L", 1.0), (".R", -1.0)):
+        hand = "hand" + side
+        present = [finger for finger in FINGER_NAMES if finger_bone_names(finger, side)[0] in index]
+        if hand not in index or not present:
+            continue
+        wrist = skeleton.joints[index[hand]]
+        palms = {}
+        for number, finger in enumerate((finger for finger in present if finger != FINGER_NAMES[0]), start=1):
+            knuckle = skeleton.joints[index[finger_bone_names(finger, side)[0]]]
+            palm = f"palm.{number:02d}{side}"
+            palms[finger] = palm
+            added.append(MetarigBone(palm, hand, wrist + PALM_START * (knuckle - wrist), knuckle.copy(), False,
+                                     PALM_RIG if number == 1 else "", ("x", sign)))
+        first_palm = f"palm.01{side}"
+        for finger in present:
+            thumb = finger == FINGER_NAMES[0]
+            parent = first_palm if thumb else palms[finger]
+            for number, name in enumerate(finger_bone_names(finger, side)[:FINGER_BONES]):
+                k = index[name]
+                added.append(MetarigBone(name, parent, skeleton.joints[k].copy(), skeleton.tails[k].copy(), number > 0,
+                                         FINGER_RIG if number == 0 else "", ("z", -1.0) if thumb else ("x", sign)))
+                parent = name
+    return tuple(added)

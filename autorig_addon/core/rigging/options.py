@@ -40,6 +40,9 @@ RIG_OPTIONS = option_table(
                       "A standard four-legged skeleton (Rigify's quadruped metarig)"),
                Choice(standard_skeleton.FREE_FORM, "Free-Form",
                       "The skeleton of the joint votes, any shape; the bandwidth sets its detail"))),
+    Option("fingers", bool, predict.DEFAULT_FINGERS, "Fingers",
+           "Give a standard biped three bones per finger when both hands have separable fingers (a mitten or a "
+           "fist gets none, and the report says so); off, each hand is one bone"),
     Option("names", str, name_presets.DEFAULT_PRESET, "Bone Names",
            "How the bones of a standard biped are named: Blender's Rigify, or a game engine's or mocap library's "
            "humanoid names (other skeletons keep Rigify's names)",

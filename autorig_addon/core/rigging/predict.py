@@ -40,6 +40,7 @@ from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
+from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
@@ -48,6 +49,7 @@ from .quality import skeleton_problems
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
+    BIPED,
     FREE_FORM,
     KIND_CONFIDENCE,
     NEAR_SYMMETRIC_ERROR,
@@ -85,6 +87,8 @@ DEFAULT_SYMMETRY = True
 #: The skeleton's template: the landmark network's guess of the body
 #: (:func:`chosen_template`).
 DEFAULT_TEMPLATE = AUTO
+#: Give a standard biped fingers when its hands have separable ones (:mod:`.fingers`).
+DEFAULT_FINGERS = True
 #: Kinds of body that have a standard skeleton.
 STANDARD_KINDS = ("biped", "quadruped")
 #: Joints this close to the mirror plane, or to their twin's mirror image,
@@ -123,6 +127,8 @@ class JointVotes:
     landmarks : Landmarks of the standard skeleton (:mod:`.standard_skeleton`),
         with the kind of body; None when only the free-form skeleton was asked for
     proxy_vertices : (n, 3) float64, the normalised proxy's vertices (None with ``landmarks``)
+    surface : Mesh, the full-resolution surface in the normalised frame, where
+        a standard biped's fingers are looked for (None: no fingers)
     """
 
     points: np.ndarray
@@ -133,6 +139,7 @@ class JointVotes:
     notes: tuple = ()
     landmarks: Landmarks | None = None
     proxy_vertices: np.ndarray | None = None
+    surface: Mesh | None = None
 
 
 def require_enough_faces(mesh: Mesh) -> None:
@@ -215,7 +222,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     if not votes.symmetric:
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
-    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices)
+    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
+                   surface=Mesh(apply_transform(surface.vertices, transform), surface.triangles))
 
 
 def framed_transform(vertices: np.ndarray, rotation: np.ndarray) -> np.ndarray:
@@ -247,14 +255,20 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
     return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices)
 
 
-def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple:
+def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton: Skeleton | None = None,
+                   fingers: bool = DEFAULT_FINGERS) -> tuple:
     """The report's notes on the template: which one and why
     (:func:`chosen_template`), then what looks wrong with a standard
-    skeleton (:func:`.standard_skeleton.landmark_warnings`)."""
+    skeleton (:func:`.standard_skeleton.landmark_warnings`), and, for a
+    standard biped ``skeleton`` asked with ``fingers`` that has none, that
+    its hands' fingers are not separable."""
     kind, note = chosen_template(votes, template)
     if kind == FREE_FORM or votes.solid is None:
         return (note,)
-    return (note, *landmark_warnings(votes.landmarks, kind, votes.solid.at))
+    fingerless = (kind == BIPED and fingers and skeleton is not None and votes.surface is not None
+                  and not has_fingers(skeleton.names))
+    return (note, *landmark_warnings(votes.landmarks, kind, votes.solid.at),
+            *((NOT_SEPARABLE_NOTE,) if fingerless else ()))
 
 
 def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple[str, str]:
@@ -334,7 +348,7 @@ def connect_joints(joints: np.ndarray, mirror: np.ndarray, solid: SolidDepth) ->
 def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWIDTH,
                         density_threshold: float = DEFAULT_DENSITY_THRESHOLD,
                         symmetry: bool = DEFAULT_SYMMETRY, template: str = DEFAULT_TEMPLATE,
-                        names: str = DEFAULT_PRESET) -> Skeleton:
+                        names: str = DEFAULT_PRESET, fingers: bool = DEFAULT_FINGERS) -> Skeleton:
     """The skeleton of the votes at a level of detail, in the mesh's space.
 
     Parameters
@@ -347,6 +361,8 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
         a standard skeleton does not depend on the bandwidth and the density threshold
     names : a preset of :data:`...skeleton.name_presets.PRESETS`; a skeleton
         that is not a standard biped keeps Rigify's names (:func:`naming_note` says so)
+    fingers : bool, give a standard biped fingers when both hands have
+        separable ones in ``votes.surface`` (:mod:`.fingers`)
 
     Returns
     -------
@@ -355,7 +371,8 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     kind, _ = chosen_template(votes, template)
     if kind != FREE_FORM:
         nearly_symmetric = symmetry and mirror_error(votes.proxy_vertices, 0) <= NEAR_SYMMETRIC_ERROR
-        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric)
+        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric,
+                                     votes.surface if fingers else None)
         to_mesh = np.linalg.inv(votes.transform)
         return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
                         preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))
@@ -416,8 +433,8 @@ def leaf_tails_inside(joints: np.ndarray, parents: np.ndarray, tails: np.ndarray
 def predict_skeleton(mesh: Mesh, *, bandwidth: float = DEFAULT_BANDWIDTH,
                      density_threshold: float = DEFAULT_DENSITY_THRESHOLD, symmetry: bool = DEFAULT_SYMMETRY,
                      template: str = DEFAULT_TEMPLATE, names: str = DEFAULT_PRESET,
-                     progress: ProgressCallback | None = None) -> Skeleton:
+                     fingers: bool = DEFAULT_FINGERS, progress: ProgressCallback | None = None) -> Skeleton:
     """:func:`predict_votes` then :func:`skeleton_from_votes`."""
     votes = predict_votes(mesh, progress)
     return skeleton_from_votes(votes, bandwidth=bandwidth, density_threshold=density_threshold, symmetry=symmetry,
-                               template=template, names=names)
+                               template=template, names=names, fingers=fingers)

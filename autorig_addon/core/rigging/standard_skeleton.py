@@ -9,7 +9,10 @@ Rigify's metarigs, named as :mod:`.role_names` names a recognised body:
   the neck, ``neck``, ``head`` up to the top of the head; per side
   ``shoulder`` (the clavicle, from near the midline), ``upper_arm``,
   ``forearm``, ``hand``; ``thigh``, ``shin``, ``foot`` (ankle to the ball of
-  the foot), ``toe``.
+  the foot), ``toe``; when both hands have separable fingers
+  (:mod:`.fingers`), per finger ``thumb``, ``f_index``, ``f_middle``,
+  ``f_ring``, ``f_pinky`` ``.01`` to ``.03`` parented to the hand, the hand
+  then ending at the knuckles.
 * **quadruped** (``basic_quadruped``): ``spine`` to ``spine.003`` from the
   hips to the neck, ``neck``, ``head`` to the snout; ``tail``,
   ``tail.001``, ``tail.002`` when the body runs on behind the hips; per side
@@ -38,7 +41,8 @@ from ..nn.numpy_kernels import NUMPY
 from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
-from ..types import Skeleton
+from ..types import Mesh, Skeleton
+from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import VERTEX_VECTORS, JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
@@ -228,23 +232,44 @@ def _foot_points(vertices: np.ndarray, ankle: np.ndarray, radius: float) -> tupl
 
 
 def _hand_tail(vertices: np.ndarray, elbow: np.ndarray, wrist: np.ndarray) -> np.ndarray:
-    """Where the hand ends: the farthest mesh point past the wrist along the
-    forearm, within a forearm's width of its line, capped at the forearm's length."""
+    """Where the hand ends: 0.85 of the way to the farthest mesh point past
+    the wrist along the forearm (:func:`.fingers.hand_extent`)."""
     direction = wrist - elbow
     length = float(np.linalg.norm(direction))
     if length <= 1e-9:
         return wrist + np.array([0.0, 0.0, 0.02])
     direction /= length
-    offsets = vertices - wrist
-    along = offsets @ direction
-    across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
-    reach = along[(along > 0) & (across <= 0.35 * length)]
-    extent = min(float(reach.max()), length) if len(reach) else HAND_SHARE * length
+    extent = hand_extent(vertices, wrist, direction, length)
+    extent = HAND_SHARE * length if extent is None else extent
     return wrist + direction * max(0.85 * extent, 0.2 * length)
 
 
-def biped_skeleton(points: dict, vertices: np.ndarray) -> Skeleton:
-    """Rigify's human layout around the landmarks (see the module docstring)."""
+def both_hands_fingers(points: dict, surface: Mesh, symmetric_shape: bool) -> dict:
+    """Each side's fingers (:func:`.fingers.hand_fingers` on the full-resolution
+    ``surface``, normalised frame), or ``{}`` unless both hands have separable
+    fingers. On a (nearly) symmetric shape the hands are made mirror images:
+    the mean of the left and the mirrored right when they found the same
+    fingers, else the hand with more fingers mirrored."""
+    found = {side: hand_fingers(surface.vertices, surface.triangles, points["elbow" + side], points["wrist" + side])
+             for side in (LEFT, RIGHT)}
+    if not all(found.values()):
+        return {}
+    if not symmetric_shape:
+        return found
+    flip = np.array([-1.0, 1.0, 1.0])
+    left, right = found[LEFT], found[RIGHT]
+    if [finger.name for finger in left] == [finger.name for finger in right]:
+        left = tuple(Finger(a.name, (a.points + b.points * flip) / 2.0) for a, b in zip(left, right))
+    elif len(right) > len(left):
+        left = tuple(Finger(finger.name, finger.points * flip) for finger in right)
+    return {LEFT: left, RIGHT: tuple(Finger(finger.name, finger.points * flip) for finger in left)}
+
+
+def biped_skeleton(points: dict, vertices: np.ndarray, fingers: dict | None = None) -> Skeleton:
+    """Rigify's human layout around the landmarks (see the module docstring);
+    with ``fingers`` (:func:`both_hands_fingers`) each hand ends at the mean
+    of its fingers' knuckles (the thumb's aside) and carries
+    :data:`.fingers.FINGER_BONES` bones per finger, parented to it."""
     build = _Builder()
     hips, neck, head = points["hips"], points["neck"], points["head"]
     spine = _spine_points(hips, neck, SPINE_BONES)
@@ -256,9 +281,16 @@ def biped_skeleton(points: dict, vertices: np.ndarray) -> Skeleton:
         shoulder, elbow, wrist = points["shoulder" + side], points["elbow" + side], points["wrist" + side]
         clavicle = np.array([0.25 * shoulder[0], shoulder[1], 0.5 * (shoulder[2] + neck[2])])
         build.add("shoulder" + side, clavicle, shoulder, "spine.003")
-        hand_end = _hand_tail(vertices, elbow, wrist)
+        hand_fingers_here = (fingers or {}).get(side, ())
+        if hand_fingers_here:
+            knuckles = [finger.points[0] for finger in hand_fingers_here if finger.name != FINGER_NAMES[0]]
+            hand_end = np.mean(knuckles, axis=0)
+        else:
+            hand_end = _hand_tail(vertices, elbow, wrist)
         build.chain(["upper_arm" + side, "forearm" + side, "hand" + side], [shoulder, elbow, wrist, hand_end],
                     "shoulder" + side)
+        for finger in hand_fingers_here:
+            build.chain(finger_bone_names(finger.name, side), list(finger.points), "hand" + side)
         hip, knee, ankle = points["hip" + side], points["knee" + side], points["ankle" + side]
         ball, tip = _foot_points(vertices, ankle, max(0.5 * abs(hip[0]), 0.03))
         build.chain(["thigh" + side, "shin" + side, "foot" + side, "toe" + side], [hip, knee, ankle, ball, tip],
@@ -341,12 +373,16 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
     return tuple(notes)
 
 
-def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool) -> Skeleton:
+def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool,
+                      surface: Mesh | None = None) -> Skeleton:
     """The standard skeleton of ``kind`` (biped or quadruped) around the
-    landmarks, in the normalised frame."""
+    landmarks, in the normalised frame; a biped gets fingers when
+    ``surface`` (the full-resolution mesh, normalised) is given and both
+    hands have separable ones (:func:`both_hands_fingers`)."""
     points = symmetrised(landmarks.points, symmetric_shape)
     if kind == BIPED:
-        return biped_skeleton(points, vertices)
+        fingers = both_hands_fingers(points, surface, symmetric_shape) if surface is not None else None
+        return biped_skeleton(points, vertices, fingers)
     if kind == QUADRUPED:
         return quadruped_skeleton(points, vertices)
     raise ValueError(f"No standard skeleton for '{kind}'.")

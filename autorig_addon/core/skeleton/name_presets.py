@@ -8,7 +8,7 @@ for each bone of the standard biped, the name under that convention:
 * ``mixamo``: Mixamo's ``mixamorig:Hips``, ``mixamorig:LeftForeArm``, ...
   (the names its animations key);
 * ``unreal``: Unreal's mannequin (``pelvis``, ``spine_01``, ``upperarm_l``,
-  ``calf_l``, ``ball_l``);
+  ``calf_l``, ``ball_l``, ``index_01_l``);
 * ``unity``: Unity's Humanoid avatar bones (``Hips``, ``Chest``,
   ``LeftUpperArm``, ``LeftToes``), which Godot's ``SkeletonProfileHumanoid``
   shares (``godot``);
@@ -31,38 +31,64 @@ RIGIFY_BONES = (
     "shoulder.L", "upper_arm.L", "forearm.L", "hand.L", "thigh.L", "shin.L", "foot.L", "toe.L",
     "shoulder.R", "upper_arm.R", "forearm.R", "hand.R", "thigh.R", "shin.R", "foot.R", "toe.R",
 )
+#: Rigify's finger names (``..rigging.fingers.FINGER_NAMES``), each 3 bones
+#: ``.01`` to ``.03``; a biped has them when its hands have separable fingers.
+RIGIFY_FINGERS = ("thumb", "f_index", "f_middle", "f_ring", "f_pinky")
+#: The finger bones, left hand then right, each finger knuckle to tip.
+FINGER_BONES = tuple(f"{finger}.{joint:02d}{side}" for side in (".L", ".R") for finger in RIGIFY_FINGERS
+                     for joint in (1, 2, 3))
 
 
-def _sided(midline: tuple, limb: tuple, left: str, right: str) -> dict:
-    """A preset's names in :data:`RIGIFY_BONES` order; ``limb`` holds ``{}``
-    where the side goes."""
+def _sided(midline: tuple, limb: tuple, left: str, right: str, fingers: tuple) -> dict:
+    """A preset's names in :data:`RIGIFY_BONES` then :data:`FINGER_BONES`
+    order; ``limb`` holds ``{}`` where the side goes, ``fingers`` one name
+    per bone of :data:`RIGIFY_FINGERS` (``{}`` for the side)."""
     names = list(midline) + [name.format(left) for name in limb] + [name.format(right) for name in limb]
-    return dict(zip(RIGIFY_BONES, names))
+    names += [name.format(left) for name in fingers] + [name.format(right) for name in fingers]
+    return dict(zip(RIGIFY_BONES + FINGER_BONES, names))
+
+
+def _finger_names(pattern: str, digits: tuple, joints: tuple, thumb_joints: tuple | None = None) -> tuple:
+    """One name per finger bone: ``pattern`` formatted with ``side`` (left
+    as ``{side}``), ``digit`` and ``joint``; the thumb's joints may differ."""
+    return tuple(pattern.replace("{digit}", digit).replace("{joint}", joint)
+                 for index, digit in enumerate(digits)
+                 for joint in (thumb_joints if index == 0 and thumb_joints else joints))
+
+
+_PHALANGES = ("Proximal", "Intermediate", "Distal")
+_METACARPAL_THUMB = ("Metacarpal", "Proximal", "Distal")
+_DIGITS = ("Thumb", "Index", "Middle", "Ring", "Little")
 
 
 _MIXAMO = _sided(("mixamorig:Hips", "mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2", "mixamorig:Neck",
                   "mixamorig:Head"),
                  ("mixamorig:{}Shoulder", "mixamorig:{}Arm", "mixamorig:{}ForeArm", "mixamorig:{}Hand",
                   "mixamorig:{}UpLeg", "mixamorig:{}Leg", "mixamorig:{}Foot", "mixamorig:{}ToeBase"),
-                 "Left", "Right")
+                 "Left", "Right",
+                 _finger_names("mixamorig:{}Hand{digit}{joint}", ("Thumb", "Index", "Middle", "Ring", "Pinky"),
+                               ("1", "2", "3")))
 _UNREAL = _sided(("pelvis", "spine_01", "spine_02", "spine_03", "neck_01", "head"),
                  ("clavicle_{}", "upperarm_{}", "lowerarm_{}", "hand_{}", "thigh_{}", "calf_{}", "foot_{}", "ball_{}"),
-                 "l", "r")
+                 "l", "r",
+                 _finger_names("{digit}_{joint}_{}", ("thumb", "index", "middle", "ring", "pinky"), ("01", "02", "03")))
 _UNITY = _sided(("Hips", "Spine", "Chest", "UpperChest", "Neck", "Head"),
                 ("{}Shoulder", "{}UpperArm", "{}LowerArm", "{}Hand", "{}UpperLeg", "{}LowerLeg", "{}Foot", "{}Toes"),
-                "Left", "Right")
+                "Left", "Right", _finger_names("{}{digit}{joint}", _DIGITS, _PHALANGES))
 _VRM = _sided(("hips", "spine", "chest", "upperChest", "neck", "head"),
               ("{}Shoulder", "{}UpperArm", "{}LowerArm", "{}Hand", "{}UpperLeg", "{}LowerLeg", "{}Foot", "{}Toes"),
-              "left", "right")
+              "left", "right", _finger_names("{}{digit}{joint}", _DIGITS, _PHALANGES, _METACARPAL_THUMB))
 
 #: Preset name -> {Rigify name: preset name}, in the panel's order; Rigify first (the default).
 PRESETS = {
-    "rigify": {name: name for name in RIGIFY_BONES},
+    "rigify": {name: name for name in RIGIFY_BONES + FINGER_BONES},
     "mixamo": _MIXAMO,
     "unreal": _UNREAL,
     "unity": _UNITY,
     "vrm": _VRM,
-    "godot": dict(_UNITY),
+    # Godot's profile names the thumb as VRM 1.0 does (metacarpal, proximal, distal).
+    "godot": {**_UNITY, **{bone: _VRM[bone][0].upper() + _VRM[bone][1:] for bone in FINGER_BONES
+                           if bone.startswith("thumb")}},
 }
 DEFAULT_PRESET = "rigify"
 #: What the panel and ``--help`` say of each preset.
@@ -110,7 +136,7 @@ def renamed(names, preset: str) -> dict:
                          f"{', '.join(PRESETS)}); predict it with the Biped template first.")
     source, target = PRESETS[current], PRESETS[preset]
     present = set(names)
-    return {source[bone]: target[bone] for bone in RIGIFY_BONES if source[bone] in present}
+    return {source[bone]: target[bone] for bone in RIGIFY_BONES + FINGER_BONES if source[bone] in present}
 
 
 
