@@ -96,6 +96,9 @@ STANDARD_KINDS = ("biped", "quadruped")
 SNAP_SHARE = 0.5
 #: Half a turn about the vertical axis.
 HALF_TURN = np.diag([-1.0, -1.0, 1.0])
+#: A landmark reading this sure of a biped or quadruped is not read again
+#: from behind to find the surer of the two (it could gain under 0.001).
+SURE_READING = 0.999
 #: Fewest faces with an area a mesh needs: below this there is no shape to read.
 MIN_FACES = 16
 #: A face whose area is below this share of the squared diagonal of the
@@ -187,34 +190,43 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     weights = shipped_weights(joint_network.SPEC).weights
     report(progress, 0.0, "Simplifying the mesh")
     proxy = simplified_proxy(surface, PROXY_VERTICES).mesh
-    readings = {}
+    readings, turned_readings = {}, {}
 
     def read(rotation: np.ndarray) -> tuple:
-        """The transform, graph, solid, landmarks and half-turned landmarks of
-        the proxy turned by ``rotation``, each read once."""
+        """The transform, graph, solid and landmarks of the proxy turned by ``rotation``, each read once."""
         key = np.round(rotation, 9).tobytes()
         if key not in readings:
             transform = framed_transform(proxy.vertices, rotation)
-            graph, solid, landmarks = _read_shape(proxy, transform, progress)
-            readings[key] = (transform, graph, solid, landmarks, predict_landmarks(half_turned(graph)))
+            readings[key] = (transform, *_read_shape(proxy, transform, progress))
         return readings[key]
+
+    def read_turned(rotation: np.ndarray) -> Landmarks:
+        """The landmarks of the proxy turned by ``rotation``, then half a turn, read once."""
+        key = np.round(rotation, 9).tobytes()
+        if key not in turned_readings:
+            turned_readings[key] = predict_landmarks(half_turned(read(rotation)[1]))
+        return turned_readings[key]
 
     def standing_reading(rotation: np.ndarray) -> Landmarks:
         """The landmarks of the proxy turned by ``rotation``, facing -Y or +Y,
         whichever reads more surely as a biped or quadruped (the kind head
-        reads a character from behind less surely)."""
-        landmarks, turned = read(rotation)[3:]
+        reads a character from behind less surely); a reading already sure
+        (:data:`SURE_READING`) is not read the other way."""
+        landmarks = read(rotation)[3]
+        if standard_confidence(landmarks) >= SURE_READING:
+            return landmarks
+        turned = read_turned(rotation)
         return landmarks if standard_confidence(landmarks) >= standard_confidence(turned) else turned
 
     notes = [inward_faces_note(int(inward.sum()), "the skeleton prediction")] if inward.any() else []
     stance = stand_upright(proxy.vertices, proxy.triangles, standing_reading)
     notes += stance.notes
     rotation = stance.rotation
-    transform, graph, solid, landmarks, turned = read(rotation)
-    if faces_backward(landmarks, graph.vertices, turned):
+    transform, graph, solid, landmarks = read(rotation)
+    if faces_backward(landmarks, graph.vertices, read_turned(rotation)):
         # Turned half a turn the character faces -y as the networks expect, its left at +x.
         rotation = HALF_TURN @ rotation
-        transform, graph, solid, landmarks = read(rotation)[:4]
+        transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y (turned, it reads as a {landmarks.kind}); it was turned half "
                      "a turn for the prediction, so its .L bones lie on its own left.")
     report(progress, 0.7, "Running the joint network")

@@ -250,10 +250,11 @@ def both_hands_fingers(points: dict, surface: Mesh, symmetric_shape: bool) -> di
     fingers. On a (nearly) symmetric shape the hands are made mirror images:
     the mean of the left and the mirrored right when they found the same
     fingers, else the hand with more fingers mirrored."""
-    found = {side: hand_fingers(surface.vertices, surface.triangles, points["elbow" + side], points["wrist" + side])
-             for side in (LEFT, RIGHT)}
-    if not all(found.values()):
-        return {}
+    found = {}
+    for side in (LEFT, RIGHT):
+        found[side] = hand_fingers(surface.vertices, surface.triangles, points["elbow" + side], points["wrist" + side])
+        if not found[side]:
+            return {}  # one mitten hand is enough to leave both as one bone: the other is not cut
     if not symmetric_shape:
         return found
     flip = np.array([-1.0, 1.0, 1.0])
