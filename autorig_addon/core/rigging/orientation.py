@@ -135,12 +135,14 @@ def best_mirror_plane(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     errors = np.array([error(normal) for normal in candidates])
     best_candidate = int(np.argmin(errors))
     if best_candidate >= 3:
-        # A mesh axis mirrors best, as it does an artist's character modelled axis-aligned: the plane is snapped
-        # to it anyway, so refining (most of this function's time) would change nothing.
+        # A mesh axis mirrors best, as it does an artist's character modelled axis-aligned: when it mirrors
+        # clearly, the plane would be snapped to it anyway, so refining (most of this function's time) is skipped.
         normal, best = candidates[best_candidate], float(errors[best_candidate])
-    else:
-        normal = _refined(candidates[best_candidate], error)
-        best = error(normal)
+        across = _best_across(normal, error)[0]
+        if best < CLEARLY_BETTER * across:
+            return normal, best, across
+    normal = _refined(candidates[best_candidate], error)
+    best = error(normal)
     across, across_normal = _best_across(normal, error)
     if across < best:
         # The coarse grid fell in the wrong basin; the plane across it is the mirror plane.
