@@ -270,3 +270,24 @@ def evaluated_world_vertices(obj) -> np.ndarray:
         evaluated.to_mesh_clear()
     points = values.reshape(-1, 3).astype(np.float64)
     return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+#: The procedural biped the rig tests use: symmetric, 0.94 tall, 0.6 wide with its arms out.
+BIPED_SEED = 0
+
+
+def armatures() -> list:
+    """Every armature object of the file."""
+    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
+
+
+def add_biped(name: str = "Biped", location=(0.0, 0.0, 0.0)) -> bpy.types.Object:
+    """The procedural biped of :data:`BIPED_SEED` as a mesh object at ``location``."""
+    from autorig_addon.core.procedural import generate_character
+
+    mesh = generate_character(BIPED_SEED, "biped").mesh
+    obj = mesh_object(name, mesh.vertices, mesh.triangles)
+    obj.location = location
+    bpy.context.view_layer.update()
+    return obj
+

@@ -15,6 +15,9 @@ from autorig_addon.blender import convert, scene_io
 from autorig_addon.cli.main import main
 from autorig_addon.core.procedural import generate_character
 from blender_fixtures import (
+    BIPED_SEED,
+    add_biped,
+    armatures,
     evaluated_world_vertices,
     group_weights,
     mesh_object,
@@ -27,8 +30,7 @@ from geometry_fixtures import box_mesh, grid
 
 pytestmark = pytest.mark.all_blenders
 
-#: A symmetric procedural biped, 0.94 tall (feet at z 0.074), 0.6 wide with its arms out.
-BIPED_SEED = 0
+# The biped (blender_fixtures.add_biped) is 0.94 tall (feet at z 0.074), 0.6 wide with its arms out.
 #: A bone tail may stick out of the character's bounding box by this share of its diagonal (a leaf's tail is
 #: extrapolated from its chain); heads may not.
 BOX_SLACK = 0.05
@@ -36,20 +38,9 @@ BOX_SLACK = 0.05
 SPECK_X = 100.0
 
 
-def armatures():
-    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
-
-
 def biped_geometry():
     mesh = generate_character(BIPED_SEED, "biped").mesh
     return mesh.vertices, mesh.triangles
-
-
-def add_biped(name="Biped", location=(0.0, 0.0, 0.0)):
-    obj = mesh_object(name, *biped_geometry())
-    obj.location = location
-    bpy.context.view_layer.update()
-    return obj
 
 
 def add_ground(name="Ground", side=4.0):

@@ -17,11 +17,12 @@ from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.blender.operators.rig import _RigOperator
 from autorig_addon.core.errors import Cancelled
 from autorig_addon.core.geometry.outward_faces import inward_faces_note
-from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
 from blender_fixtures import (
     RecordingWindowManager,
     RecordingWorkspace,
+    add_biped,
+    armatures,
     group_weights,
     make_armature,
     mesh_object,
@@ -33,24 +34,12 @@ from geometry_fixtures import triangle_and_flat_triangles
 
 pytestmark = pytest.mark.all_blenders
 
-#: A symmetric procedural biped (1,866 vertices, 29 bones in its own rig, 1.0 tall).
-BIPED_SEED = 0
+# The biped (blender_fixtures.add_biped): 1,866 vertices, 29 bones in its own rig.
 #: A bone tail may stick out of the mesh's bounding box by this share of its
 #: diagonal (a leaf's tail is extrapolated from its chain); heads may not.
 BOX_SLACK = 0.05
 #: Two levels of detail around the default (a smaller bandwidth gives more joints).
 FINE_BANDWIDTH, COARSE_BANDWIDTH = 0.75 * predict.DEFAULT_BANDWIDTH, 4 * predict.DEFAULT_BANDWIDTH
-
-
-def armatures():
-    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
-
-
-def add_biped(name="Biped"):
-    character = generate_character(BIPED_SEED, "biped")
-    obj = mesh_object(name, character.mesh.vertices, character.mesh.triangles)
-    bpy.context.view_layer.update()
-    return obj
 
 
 @pytest.fixture

@@ -18,6 +18,9 @@ from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.procedural import generate_character
 from blender_fixtures import (
+    BIPED_SEED,
+    add_biped,
+    armatures,
     bind,
     evaluated_world_vertices,
     group_weights,
@@ -31,8 +34,7 @@ from geometry_fixtures import box_mesh
 
 pytestmark = pytest.mark.all_blenders
 
-#: The procedural biped (0.94 tall, facing -Y, arms out and down; its right hand around x -0.28, z 0.57).
-BIPED_SEED = 0
+# The biped (blender_fixtures.add_biped): 0.94 tall, facing -Y, arms out and down; its right hand near x -0.28, z 0.57.
 #: The sword: a blade 1.6 cm square from its pommel 3 cm behind the right hand to its tip 0.5 forward.
 SWORD_LOW, SWORD_HIGH = (-0.286, -0.5, 0.565), (-0.27, 0.03, 0.581)
 #: Where the sword passes through the right hand.
@@ -41,17 +43,6 @@ GRIP = np.array([-0.278, -0.01, 0.573])
 GRIP_DISTANCE = 0.03
 #: Sword vertices this far before the hand are its blade: no bone may come this close to them.
 BLADE_CLEARANCE = 0.1
-
-
-def armatures():
-    return [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
-
-
-def add_biped():
-    mesh = generate_character(BIPED_SEED, "biped").mesh
-    obj = mesh_object("Biped", mesh.vertices, mesh.triangles)
-    bpy.context.view_layer.update()
-    return obj
 
 
 def add_sword():
