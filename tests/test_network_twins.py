@@ -19,7 +19,7 @@ from autorig_addon.core.rigging.tree_features import (
     pair_features,
     root_features,
 )
-from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT, candidate_features, surface_points
+from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT, area_centroids, candidate_features
 from autorig_addon.core.skinning.learned import predict
 from autorig_addon.core.skinning.learned.features import PRIOR_FLOOR, skin_graph
 from autorig_addon.core.skinning.learned.networks import SKIN_NETWORKS
@@ -108,7 +108,7 @@ def procedural_inputs():
     inputs.update(joints=graph, landmarks=graph,
                   bones=pair_features(joints, candidate_pairs(joints), solid, np.full(len(joints), -1)),
                   root=root_features(joints, solid),
-                  upright=candidate_features(*surface_points(sample.mesh.vertices, sample.mesh.triangles)).astype(
+                  upright=candidate_features(*area_centroids(sample.mesh.vertices, sample.mesh.triangles)).astype(
                       np.float32))
     return inputs
 

@@ -44,8 +44,8 @@ from ..nn.numpy_kernels import NUMPY
 from ..nn.spec import shipped_weights
 from .networks import upright as upright_network
 from .standard_skeleton import KIND_CONFIDENCE, TURNED_CONFIDENCE_GAIN, standard_confidence
-from .symmetry import CLEARLY_BETTER
-from .up_features import MIDLINE_SHARE, UP_BANDS, UP_CANDIDATES, candidate_features, surface_points
+from .symmetry import CLEARLY_BETTER, mirror_error_across
+from .up_features import MIDLINE_SHARE, UP_BANDS, UP_CANDIDATES, area_centroids, candidate_features
 
 #: Angle (degrees) about the best candidate mirror-plane normal within
 #: which it is refined, on a 7 x 7 grid, then again three times finer.
@@ -95,20 +95,6 @@ FEET_BALANCE = 0.3
 #: mirror plane: the two faces of a thin plate, a fish's fins, are not feet
 #: (every cached humanoid and quadruped whose feet the cue finds stands wider).
 FEET_HALF_WIDTH = 0.06
-
-
-def mirror_error_across(points: np.ndarray, normal: np.ndarray, tree: cKDTree | None = None,
-                        sample: np.ndarray | None = None) -> float:
-    """Mean distance from ``sample`` (default ``points``, (n, 3)) mirrored
-    across the plane with unit ``normal`` (3,) halfway along the points'
-    extent in that direction (their bounding box's centre plane, for an
-    axis) to the nearest of ``points`` (``tree``: their cKDTree)."""
-    heights = points @ normal
-    middle = 0.5 * (heights.min() + heights.max())
-    sample = points if sample is None else sample
-    offsets = sample @ normal - middle
-    mirrored = sample - 2.0 * offsets[:, None] * normal[None, :]
-    return float((tree or cKDTree(points)).query(mirrored)[0].mean())
 
 
 def best_mirror_plane(points: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -238,7 +224,7 @@ def up_probabilities(points: np.ndarray, triangles: np.ndarray, weights: dict | 
     upright network, for a mesh (``points`` (n, 3), ``triangles`` (m, 3))
     whose mirror plane is x = const."""
     weights = shipped_weights(upright_network.SPEC).weights if weights is None else weights
-    surface, shares = surface_points(points, triangles)
+    surface, shares = area_centroids(points, triangles)
     scores = np.asarray(upright_network.SPEC.forward(NUMPY, weights, candidate_features(surface, shares)),
                         dtype=np.float64).reshape(-1)
     exp = np.exp(scores - scores.max())
@@ -251,7 +237,7 @@ def lowest_band(points: np.ndarray, triangles: np.ndarray) -> tuple[float, float
     box centre: the share of its area on the midline (|x| within
     :data:`.up_features.MIDLINE_SHARE` of the band's half width), the share
     on its less covered side, and its half width (share of the largest side)."""
-    surface, shares = surface_points(points, triangles)
+    surface, shares = area_centroids(points, triangles)
     heights = surface[:, 2] - surface[:, 2].min()
     band = heights < heights.max() / UP_BANDS
     x = surface[band, 0] - 0.5 * (points[:, 0].min() + points[:, 0].max())

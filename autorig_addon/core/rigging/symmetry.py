@@ -27,10 +27,21 @@ CLEARLY_BETTER = 0.5
 def mirror_error(vertices: np.ndarray, axis: int) -> float:
     """Mean distance from the vertices mirrored across the plane through
     the bounding-box centre perpendicular to ``axis`` to the nearest vertex."""
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
-    mirrored = vertices.copy()
-    mirrored[:, axis] = (low[axis] + high[axis]) - mirrored[:, axis]
-    return float(cKDTree(vertices).query(mirrored)[0].mean())
+    return mirror_error_across(vertices, np.eye(3)[axis])
+
+
+def mirror_error_across(points: np.ndarray, normal: np.ndarray, tree: cKDTree | None = None,
+                        sample: np.ndarray | None = None) -> float:
+    """Mean distance from ``sample`` (default ``points``, (n, 3)) mirrored
+    across the plane with unit ``normal`` (3,) halfway along the points'
+    extent in that direction (their bounding box's centre plane, for an
+    axis) to the nearest of ``points`` (``tree``: their cKDTree)."""
+    heights = points @ normal
+    middle = 0.5 * (heights.min() + heights.max())
+    sample = points if sample is None else sample
+    offsets = sample @ normal - middle
+    mirrored = sample - 2.0 * offsets[:, None] * normal[None, :]
+    return float((tree or cKDTree(points)).query(mirrored)[0].mean())
 
 
 def mirror_points(points: np.ndarray) -> np.ndarray:

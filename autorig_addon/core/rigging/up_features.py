@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.normals import triangle_double_areas
 
 #: Height bands the up cues are measured in (bottom to top).
 UP_BANDS = 8
@@ -30,15 +31,14 @@ END_SHARE = 0.03
 UP_FEATURE_COUNT = 6 + 5 * UP_BANDS
 
 
-def surface_points(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def area_centroids(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Triangle centroids (m, 3) and their share of the area (m,), summing
     to 1: the surface evenly, whatever the mesh's vertex density."""
-    corners = vertices[triangles]
-    areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    areas = triangle_double_areas(vertices, triangles)
     total = areas.sum()
     if total <= 0.0:
         raise InputError("The mesh has no faces with an area, so which way is up cannot be read.")
-    return corners.mean(axis=1), areas / total
+    return vertices[triangles].mean(axis=1), areas / total
 
 
 def up_features(points: np.ndarray, shares: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from ...core.geometry.proxy import simplified_proxy
 from ...core.rigging.joint_features import PROXY_VERTICES
-from ...core.rigging.up_features import candidate_features, surface_points
+from ...core.rigging.up_features import area_centroids, candidate_features
 from ...core.types import Mesh
 
 #: Tilted copies of each skeleton family, shared among its characters (at least one each).
@@ -49,7 +49,7 @@ def upright_data(samples: list, copies: list[int], rng: np.random.Generator) -> 
     roots = []
     for sample, count in zip(samples, copies):
         proxy = simplified_proxy(Mesh(sample.vertices, sample.triangles), PROXY_VERTICES).mesh
-        points, shares = surface_points(proxy.vertices, proxy.triangles)
+        points, shares = area_centroids(proxy.vertices, proxy.triangles)
         for _ in range(count):
             axis = rng.normal(size=3)
             angle = np.radians(rng.uniform(0.0, TILT_DEGREES))
