@@ -33,6 +33,7 @@ from autorig_addon.core.skinning.methods import (
     skin_weights,
 )
 from autorig_addon.core.skinning.options import SkinningOptions, ignored_options
+from autorig_addon.core.skinning.rigid_parts import rigid_weights
 from geometry_fixtures import cylinder, two_bone_skeleton
 
 #: Height of the test tube; its two bones meet at half of it.
@@ -104,7 +105,7 @@ def test_geometric_runs_geometric_weights_with_every_option():
     mesh, skeleton = tube(), two_bone_skeleton(TUBE_HEIGHT)
     chosen = skin_weights(mesh, skeleton, SkinningOptions(GEOMETRIC, max_influences=1, resolution=RESOLUTION,
                                                           distance="geodesic", falloff=8.0, smoothing_iterations=2,
-                                                          smoothing_strength=0.3))
+                                                          smoothing_strength=0.3, rigid_parts=False))
     direct = geometric.geometric_weights(mesh, skeleton, distance="geodesic", resolution=RESOLUTION, falloff=8.0,
                                          max_influences=1, smoothing_iterations=2, smoothing_strength=0.3)
     assert chosen.bone_names == direct.bone_names
@@ -115,13 +116,18 @@ def test_geometric_runs_geometric_weights_with_every_option():
 def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(network):
     character = generate_character(CHARACTER_SEED, CHARACTER_KIND)
     mesh, skeleton = character.mesh, character.skeleton
-    chosen = skin_weights(mesh, skeleton, SkinningOptions(network, max_influences=1, resolution=RESOLUTION,
-                                                          distance="geodesic", falloff=8.0, smoothing_iterations=2,
-                                                          smoothing_strength=0.3))
+    options = SkinningOptions(network, max_influences=1, resolution=RESOLUTION, distance="geodesic", falloff=8.0,
+                              smoothing_iterations=2, smoothing_strength=0.3, rigid_parts=False)
+    chosen = skin_weights(mesh, skeleton, options)
     direct = learned_weights(mesh, skeleton, network, max_influences=1, resolution=RESOLUTION)
     deform_names = tuple(name for name, deforms in zip(skeleton.names, skeleton.deform) if deforms)
     assert chosen.bone_names == direct.bone_names == deform_names
     np.testing.assert_array_equal(chosen.matrix, direct.matrix)
+    # By default each loose part weighted mostly to one bone is then bound wholly to it.
+    rigid = skin_weights(mesh, skeleton, replace(options, rigid_parts=True))
+    expected, count = rigid_weights(mesh, direct.matrix)
+    assert count > 0 and not np.array_equal(expected, direct.matrix)
+    np.testing.assert_array_equal(rigid.matrix, expected)
 
 
 def test_rignet_refuses_a_skeleton_smaller_than_its_candidate_set():
@@ -162,13 +168,16 @@ def test_ignored_options_are_the_changed_geometric_ones_with_a_network():
 
 
 @pytest.mark.parametrize("network", NETWORK_NAMES)
-def test_eval_scores_each_network_as_learned_weights(network):
+def test_eval_scores_each_network_as_the_skin_job_gives_it(network):
     evaluation_methods.check_method("skin", network)  # accepted
     assert network in evaluation_methods.method_names("skin")
     character = generate_character(CHARACTER_SEED, CHARACTER_KIND)
     mesh, skeleton = character.mesh, character.skeleton
     predicted = evaluation_methods.SKIN_METHODS[network].predict(evaluation_methods.SkinInput(mesh, skeleton))
-    np.testing.assert_array_equal(predicted.matrix, learned_weights(mesh, skeleton, network).matrix)
+    # The network's weights with its rigid loose parts bound wholly to their bone, as a user gets them.
+    expected, count = rigid_weights(mesh, learned_weights(mesh, skeleton, network).matrix)
+    assert count > 0
+    np.testing.assert_array_equal(predicted.matrix, expected)
 
 
 # --------------------------------------------------------------------------- command line

@@ -155,7 +155,9 @@ def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, cap
 def test_a_helmet_and_a_bracer_on_one_arm_are_skinned_not_held(clean_scene, capfd):
     """A helmet has a twin of itself across the mirror plane; a bracer on the
     right forearm has none but lies on the body: both are skinned as the
-    body is, over several bones."""
+    body is, through vertex groups, not held by one bone. The bracer, one
+    piece weighted mostly to the forearm, is then bound wholly to it (a
+    rigid loose part); without rigid parts it spreads over several bones."""
     body = add_biped()
     helmet = add_shell("Helmet", lambda vertices: vertices[:, 2] > 0.86)
     bracer = add_shell("Bracer", lambda vertices: (vertices[:, 0] < -0.2) & (vertices[:, 0] > -0.25))
@@ -170,6 +172,12 @@ def test_a_helmet_and_a_bracer_on_one_arm_are_skinned_not_held(clean_scene, capf
         weights = group_weights(garment, skeleton.names)
         np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
         assert garment.parent == armature
+    bracer_weights = group_weights(bracer, skeleton.names)
+    np.testing.assert_allclose(bracer_weights[:, skeleton.names.index("forearm.R")], 1.0, atol=1e-6)
+
+    # Skinned again with the body, rigid parts off.
+    select_only([armature, body, helmet, bracer], active=armature)
+    assert bpy.ops.autorig.skin_weights(skin_rigid_parts=False) == {"FINISHED"}
     bracer_bones = group_weights(bracer, skeleton.names).max(axis=0) > 0.1
     assert bracer_bones.sum() >= 2 and bracer_bones[skeleton.names.index("forearm.R")]
 

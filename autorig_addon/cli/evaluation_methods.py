@@ -182,19 +182,15 @@ def _nearest_bone(task: SkinInput):
     return nearest_bone_weights(task.mesh, task.skeleton)
 
 
-def _geometric(task: SkinInput):
-    from ..core.skinning.geometric import geometric_weights
-
-    return geometric_weights(task.mesh, task.skeleton)
-
-
-def _network(name: str) -> Callable:
-    """The skin method running the shipped network ``name`` (``core.skinning.learned``) with its defaults."""
+def _skin_method(name: str) -> Callable:
+    """The skin method ``name`` (the geometric method or a shipped network)
+    with the Skin job's defaults, as a user gets it (rigid loose parts included)."""
 
     def predict(task: SkinInput):
-        from ..core.skinning.learned.predict import learned_weights
+        from ..core.skinning.methods import skin_weights
+        from ..core.skinning.options import SkinningOptions
 
-        return learned_weights(task.mesh, task.skeleton, name)
+        return skin_weights(task.mesh, task.skeleton, SkinningOptions(method=name))
 
     return predict
 
@@ -243,9 +239,11 @@ def _robust_transfer(source, source_weights, target):
 
 register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone heat) on a copy without vertex groups")
 register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
-register_skin_method("geometric", _geometric, "core.skinning.geometric.geometric_weights with its defaults")
+register_skin_method("geometric", _skin_method("geometric"),
+                     "core.skinning.geometric with the Skin job's defaults (rigid loose parts)")
 for _name in NETWORK_NAMES:
-    register_skin_method(_name, _network(_name), f"{SKIN_METHOD_DESCRIPTIONS[_name]} (core.skinning.learned)")
+    register_skin_method(_name, _skin_method(_name),
+                         f"{SKIN_METHOD_DESCRIPTIONS[_name]} (core.skinning.learned; rigid loose parts)")
 register_rig_method(
     "nearest_character", _nearest_character,
     "the learning-free baseline: the training character with the closest normalised surface (Chamfer), "

@@ -121,6 +121,7 @@ class VIEW3D_PT_autorig_skin(_AutoRigSubPanel, bpy.types.Panel):
         column.prop(settings, "skin_method")
         column.prop(settings, "skin_resolution")
         column.prop(settings, "skin_max_influences")
+        column.prop(settings, "skin_rigid_parts")
         column.prop(settings, "skin_replace_all")
         # The networks ignore the geometric method's own options.
         column = layout.column(align=True)

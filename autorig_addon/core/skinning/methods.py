@@ -26,6 +26,7 @@ from ..types import Mesh, Skeleton, Weights
 from .geometric import geometric_weights
 from .learned.networks import NETWORK_NAMES, SKIN_NETWORKS
 from .learned.predict import learned_weights
+from .rigid_parts import rigid_weights
 
 #: The method without training: :func:`.geometric.geometric_weights`.
 GEOMETRIC = "geometric"
@@ -74,7 +75,9 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
     -------
     Weights with one column per deform bone (in skeleton order); every row
     is non-negative, sums to 1 and has at most ``options.max_influences``
-    non-zeros (when that is above 0).
+    non-zeros (when that is above 0). With ``options.rigid_parts``, each
+    loose part the method weighted mostly to one bone is bound wholly to it
+    (:mod:`.rigid_parts`).
 
     Raises
     ------
@@ -85,7 +88,12 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
     # Every method's proxy and the networks' normals follow the winding: read it outward whatever the file's.
     mesh = outward_mesh(mesh)[0]
     if options.method != GEOMETRIC:
-        return learned_weights(mesh, skeleton, options.method, max_influences=options.max_influences,
-                               resolution=options.resolution, progress=progress)
-    return geometric_weights(mesh, skeleton, max_influences=options.max_influences, resolution=options.resolution,
-                             progress=progress, **{name: getattr(options, name) for name in GEOMETRIC_OPTIONS})
+        weights = learned_weights(mesh, skeleton, options.method, max_influences=options.max_influences,
+                                  resolution=options.resolution, progress=progress)
+    else:
+        weights = geometric_weights(mesh, skeleton, max_influences=options.max_influences,
+                                    resolution=options.resolution, progress=progress,
+                                    **{name: getattr(options, name) for name in GEOMETRIC_OPTIONS})
+    if not options.rigid_parts:
+        return weights
+    return Weights(rigid_weights(mesh, weights.matrix)[0], weights.bone_names)

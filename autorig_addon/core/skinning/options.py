@@ -45,6 +45,8 @@ class SkinningOptions:
     max_influences : int >= 0, bones kept per vertex (0: no limit)
     smoothing_iterations : int >= 0, extra surface smoothing passes; geometric method only
     smoothing_strength : float in [0, 1], blend factor of one pass; geometric method only
+    rigid_parts : bool, bind each loose part whose weights lie mostly on one bone wholly to it
+        (:mod:`.rigid_parts`); every method
     """
 
     method: str = DEFAULT_SKIN_METHOD
@@ -54,6 +56,7 @@ class SkinningOptions:
     max_influences: int = geometric.DEFAULT_MAX_INFLUENCES
     smoothing_iterations: int = geometric.DEFAULT_SMOOTHING_ITERATIONS
     smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
+    rigid_parts: bool = True
 
 
 def ignored_options(options: SkinningOptions) -> tuple[str, ...]:
@@ -106,6 +109,9 @@ SKINNING_OPTIONS = option_table(*map(_saying_geometric_only, (
            low=0, high=MAX_SMOOTHING_ITERATIONS),
     Option("smoothing_strength", float, DEFAULT_SMOOTHING_STRENGTH, "Smoothing Strength",
            "Blend factor of one smoothing pass", low=0.0, high=1.0, unit=FRACTION),
+    Option("rigid_parts", bool, True, "Rigid Loose Parts",
+           "Bind each separate piece of the mesh whose weights lie mostly on one bone wholly to that bone "
+           "(a robot's plates, armour pieces, eyes); pieces that span a joint keep their blend"),
     Option("replace_all", bool, False, "Replace All Groups",
            "Remove every existing vertex group of the meshes first (otherwise only the deform bones' groups "
            "are replaced)"),
