@@ -237,3 +237,31 @@ def test_no_fingers_gives_the_22_bones_on_a_biped_with_fingers_and_fingers_the_5
         counts[switch] = (item["bones"], len(armature.data.bones),
                           sum(bone.name.startswith(("thumb", "f_")) for bone in armature.data.bones))
     assert counts == {"--no-fingers": (22, 22, 0), "--fingers": (52, 52, 30)}
+
+
+def test_rigid_parts_bind_each_piece_mostly_on_one_bone_wholly_to_it_unless_switched_off(clean_scene, tmp_path,
+                                                                                          capsys):
+    """The procedural biped is 13 loose pieces (limb boxes, head, torso):
+    by default the pieces weighted mostly to one bone are bound wholly to it,
+    exactly ``rigid_weights`` of what ``--no-rigid-parts`` gives."""
+    from autorig_addon.core.skinning.rigid_parts import rigid_weights
+    from autorig_addon.core.types import Mesh
+
+    source = tmp_path / "hero.glb"
+    save_biped(source)
+    results = {}
+    for flag in ("--rigid-parts", "--no-rigid-parts"):
+        out = tmp_path / f"hero{flag}.blend"
+        code, _, _ = run_main(["rig", str(source), "--out", str(out), "--template", "biped", flag, "--quiet"],
+                              capsys)
+        assert code == 0
+        armature, mesh = the_armature_and_mesh(out)
+        bones = [bone.name for bone in armature.data.bones if bone.use_deform]
+        vertices = np.array([vertex.co[:] for vertex in mesh.data.vertices])
+        triangles = np.array([polygon.vertices[:] for polygon in mesh.data.polygons])
+        results[flag] = (Mesh(vertices, triangles), read_weights(mesh, bones).matrix)
+    shape, smooth = results["--no-rigid-parts"]
+    expected, count = rigid_weights(shape, smooth)
+    assert count >= 1
+    np.testing.assert_allclose(results["--rigid-parts"][1], expected, atol=1e-6)
+    assert not np.allclose(smooth, expected, atol=1e-3)

@@ -24,7 +24,8 @@ from ..core.errors import InputError
 from ..core.messages import listed_names
 from ..core.rigging.options import RIG_OPTIONS
 from ..core.skinning.methods import DEFAULT_SKIN_METHOD, SKIN_METHODS
-from .arguments import add_options
+from ..core.skinning.options import SKINNING_OPTIONS
+from .arguments import add_option, add_options
 from .batch import add_batch_arguments, run_batch
 
 NAME = "rig"
@@ -44,6 +45,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"How the meshes are weighted to the new skeleton ({NO_SKIN}: the armature alone, meshes unbound; "
              f"default {DEFAULT_SKIN_METHOD}; see the skin subcommand)",
     )
+    add_option(parser, SKINNING_OPTIONS["rigid_parts"])
     parser.add_argument("--rigify", action="store_true",
                         help="Build Rigify's control rig (IK/FK limbs, torso and head controls) from the standard "
                              "skeleton and bind the meshes to its DEF- bones (needs a biped or quadruped: the "
@@ -94,7 +96,8 @@ def run(args: argparse.Namespace) -> int:
 
     settings = RigSettings(args.bandwidth, args.density_threshold, args.symmetry, args.template, args.names,
                            args.fingers)
-    skin = None if args.skin == NO_SKIN else SkinSettings(SkinningOptions(method=args.skin))
+    skin = None if args.skin == NO_SKIN else SkinSettings(SkinningOptions(method=args.skin,
+                                                                          rigid_parts=args.rigid_parts))
 
     def process(input_path, output_path, progress):
         import bpy
