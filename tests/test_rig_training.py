@@ -3,6 +3,8 @@ shared loop (training/nn/fit.py): tiny runs on procedural characters that
 reproduce with their seed, keep their best epoch and write weights the
 predictor reads."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,7 @@ from autorig_addon.core.nn.weights_io import load_weights
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT
+from autorig_addon.training.rigging.proportions import proportion_variant, reproportioned, source_character
 from autorig_addon.training.rigging.training_set import reference_skeleton, sample_examples
 from geometry_fixtures import procedural_sample
 
@@ -19,6 +22,7 @@ pytestmark = pytest.mark.torch
 
 from autorig_addon.training.rigging.landmarks import (  # noqa: E402
     MIRRORED,
+    UNTAUGHT_KIND,
     holdout_scores,
     landmark_data,
     sample_landmarks,
@@ -166,3 +170,55 @@ def test_the_upright_network_learns_which_way_is_up_and_its_run_reproduces():
 def test_copies_are_shared_out_so_each_family_weighs_alike():
     families = {"a1": 0, "a2": 0, "a3": 0, "a4": 0, "b": 1, "c1": 2, "c2": 2}
     assert copies_per_character(sorted(families), families) == [4, 4, 4, 4, 16, 8, 8]
+
+
+def test_a_proportion_variant_moves_every_joint_with_the_mesh_and_counts_as_its_character():
+    sample = procedural_sample(5)
+    variant = proportion_variant(sample, 1, seed=0)
+    assert variant.name == "procedural_5~proportions1"
+    assert source_character(variant.name + "#0") == source_character("procedural_5#3") == "procedural_5"
+    # Normalised again: feet on the ground, largest side 1.
+    assert variant.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-12)
+    assert np.ptp(variant.vertices, axis=0).max() == pytest.approx(1.0, abs=1e-12)
+    # The same map on any point: a joint exactly at a vertex stays exactly at that vertex.
+    glued = replace(sample, joints=sample.vertices[[10, 200, 500]], tails=sample.vertices[[11, 201, 501]],
+                    parents=np.array([-1, 0, 1]), names=("a", "b", "c"), deform=np.ones(3, dtype=bool),
+                    weights=np.zeros((len(sample.vertices), 3)))
+    moved = proportion_variant(glued, 1, seed=0)
+    np.testing.assert_allclose(moved.joints, moved.vertices[[10, 200, 500]], atol=1e-12)
+    np.testing.assert_allclose(moved.tails, moved.vertices[[11, 201, 501]], atol=1e-12)
+    # Heights keep their order (the map increases) but the bands' shares change: proportions, not a scale.
+    order = np.argsort(sample.vertices[:, 2], kind="stable")
+    assert np.all(np.diff(variant.vertices[order, 2]) >= -1e-12)
+    ratio = variant.vertices[:, 2] / np.where(sample.vertices[:, 2] > 0, sample.vertices[:, 2], np.nan)
+    assert np.nanmax(ratio) / np.nanmin(ratio) > 1.2
+    # Reproducible from the seed, and another number is another map.
+    np.testing.assert_array_equal(proportion_variant(sample, 1, seed=0).vertices, variant.vertices)
+    assert not np.allclose(proportion_variant(sample, 2, seed=0).vertices, variant.vertices)
+
+
+def test_a_band_map_has_the_heights_and_widths_it_was_drawn_with():
+    heights, widths = np.array([0.0, 0.1, 0.3, 0.6, 0.7]), np.array([1.0, 1.0, 2.0, 1.0, 1.0])
+    points = np.array([[0.1, 0.2, 0.0], [0.1, 0.2, 0.25], [0.1, 0.2, 0.5], [0.1, 0.2, 0.625], [0.1, 0.2, 1.0]])
+    moved = reproportioned(points, 1.0, heights, widths)
+    # Band edges go to the drawn heights; half way up the third band is half way between its new edges.
+    np.testing.assert_allclose(moved[:, 2], [0.0, 0.1, 0.3, 0.45, 0.7])
+    # Width factor 2 at half height, 1.5 half way to the next edge, about the vertical axis.
+    np.testing.assert_allclose(moved[:, :2], [[0.1, 0.2], [0.1, 0.2], [0.2, 0.4], [0.15, 0.3], [0.1, 0.2]])
+
+
+def test_a_proportion_variant_teaches_its_moved_landmarks_and_no_kind():
+    sample = procedural_sample(23)  # a biped: all 15 key joints named
+    variant = proportion_variant(sample, 2, seed=0)
+    (example,) = sample_examples(variant, np.random.default_rng(0), variants=0)
+    ((_, targets, known, kind),) = landmark_data({variant.name: variant}, [example])
+    assert kind == UNTAUGHT_KIND
+    expected, expected_known, own_kind = sample_landmarks(variant)
+    np.testing.assert_array_equal(known, expected_known)
+    assert known.sum() == 15
+    np.testing.assert_allclose(targets[known > 0], expected[known > 0], atol=1e-5)
+    # Reshaped: the variant's landmarks are not the character's.
+    assert np.abs(targets - sample_landmarks(sample)[0]).max() > 0.01
+    # The character itself still teaches its kind.
+    ((_, _, _, kind),) = landmark_data({sample.name: sample}, sample_examples(sample, np.random.default_rng(0), 0))
+    assert kind == own_kind != UNTAUGHT_KIND

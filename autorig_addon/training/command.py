@@ -24,6 +24,7 @@ from ..core.dataset.cache import default_cache_dir
 from ..core.rigging.networks import NETWORK_NAMES as RIG_NETWORK_NAMES
 from ..core.rigging.networks import RIG_NETWORKS
 from ..core.skinning.learned.networks import NETWORK_NAMES, SKIN_NETWORKS
+from .rigging.proportions import DEFAULT_PROPORTION_VARIANTS
 
 NAME = "train"
 HELP = "Train the skinning and skeleton networks from cached samples of the training characters"
@@ -63,6 +64,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--procedural", type=int, default=0,
                         help="Also train on this many procedural characters (seeds 0 to N-1, exact skeletons; "
                              "never held out; default 0)")
+    parser.add_argument("--proportion-variants", type=int, default=DEFAULT_PROPORTION_VARIANTS,
+                        help="train rig --model landmarks: reshaped copies (other leg, trunk and head lengths) of "
+                             f"each training character with key joints (default {DEFAULT_PROPORTION_VARIANTS})")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -87,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
 
         record = run_rig_training(args.model, sample_dir=samples, examples_dir=args.examples, epochs=args.epochs,
                                   learning_rate=args.learning_rate, seed=args.seed, device=args.device,
-                                  output=args.output, procedural=args.procedural)
+                                  output=args.output, procedural=args.procedural,
+                                  proportion_variants=args.proportion_variants)
     print(f"{record.network}: kept epoch {record.best_epoch} of {record.epochs}, held-out {record.score_name} "
           f"{record.best_score:.4f}, {record.seconds:.0f} s on {record.device}", file=sys.stderr)
     return EXIT_OK

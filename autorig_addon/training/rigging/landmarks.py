@@ -40,10 +40,15 @@ from ..nn.fit import FitRecord, fit
 from ..nn.modules import NetworkModule, as_tensors
 from ..nn.torch_kernels import TORCH
 from ..runs import character_families, epoch_step_count, epoch_steps
+from .proportions import VARIANT_MARK, source_character
 from .training_set import RigExample, reference_skeleton
 
 #: Weight of the kind's cross-entropy beside the landmark distance (normalised units).
 KIND_LOSS_WEIGHT = 0.05
+#: The kind of a proportion variant: none taught. Reshaped bipeds taught as bipeds moved the kind head (validation
+#: standing monsters read as "other"), so the variants teach where the landmarks lie and the kind is learnt from the
+#: characters' own shapes, as before.
+UNTAUGHT_KIND = -1
 #: The split's kinds of character (and the procedural generator's) and the body kind each teaches.
 CATEGORY_KINDS = {"humanoid": "biped", "quadruped": "quadruped", "biped": "biped"}
 #: Each landmark's mirror twin (itself on the midline), as indices.
@@ -79,11 +84,15 @@ def variant_landmarks(sample: CharacterSample, example: RigExample, targets: np.
 
 
 def landmark_data(samples: dict, examples: list) -> list:
-    """(graph, targets, known, kind) per example."""
+    """(graph, targets, known, kind) per example; ``kind`` is
+    :data:`UNTAUGHT_KIND` for a proportion variant (:mod:`.proportions`),
+    which teaches the landmarks alone."""
     data = []
     for example in examples:
         sample = samples[example.name.rsplit("#", 1)[0]]
         targets, known, kind = sample_landmarks(sample)
+        if VARIANT_MARK in example.name:
+            kind = UNTAUGHT_KIND
         data.append((example.graph, variant_landmarks(sample, example, targets).astype(np.float32), known, kind))
     return data
 
@@ -99,6 +108,8 @@ def landmark_loss(module: NetworkModule, item: tuple, matrix: np.ndarray) -> tor
     landmarks, logits = module(turned)
     distances = ((landmarks - targets @ turn.T) ** 2).sum(dim=1).clamp_min(1e-12).sqrt()
     landmark_term = (distances * known).sum() / known.sum().clamp_min(1.0)
+    if kind == UNTAUGHT_KIND:
+        return landmark_term
     kind_term = torch.nn.functional.cross_entropy(logits, torch.as_tensor([kind], device=targets.device))
     return landmark_term + KIND_LOSS_WEIGHT * kind_term
 
@@ -135,7 +146,7 @@ def train_landmark_network(samples: dict, train: list, holdout: list, record: Fi
     held_data = landmark_data(samples, holdout)
     tensors = [(as_tensors(graph, record.device), torch.as_tensor(targets, device=record.device),
                 torch.as_tensor(known, device=record.device), kind) for graph, targets, known, kind in train_data]
-    characters = [example.name.rsplit("#", 1)[0] for example in train]
+    characters = [source_character(example.name) for example in train]
     families = character_families(characters)
     steps = epoch_step_count(characters, families)
     record.details.update(train_characters=len(set(characters)), steps_per_epoch=steps,

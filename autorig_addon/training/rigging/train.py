@@ -63,7 +63,8 @@ from ..runs import (
     start_run,
     write_weights,
 )
-from .landmarks import train_landmark_network
+from .landmarks import sample_landmarks, train_landmark_network
+from .proportions import DEFAULT_PROPORTION_VARIANTS, reshaped_variants
 from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
 from .upright import copies_per_character, upright_data
 
@@ -244,12 +245,15 @@ def train_full_batch(spec: NetworkSpec, train_data: dict, held_data: dict, recor
 
 def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[Path] = None,
                      epochs: Optional[int] = None, learning_rate: Optional[float] = None, seed: int = 0,
-                     device: str = "auto", output: Optional[Path] = None, procedural: int = 0) -> FitRecord:
+                     device: str = "auto", output: Optional[Path] = None, procedural: int = 0,
+                     proportion_variants: int = DEFAULT_PROPORTION_VARIANTS) -> FitRecord:
     """Train ``network`` (any of ``core.rigging.networks.NETWORK_NAMES``) and write its weights; returns the record.
 
     ``procedural`` adds the procedural characters of seeds ``0 .. procedural - 1``
     (exact skeletons) as training characters; they are never held out, so
-    the epoch is still chosen on artists' rigs.
+    the epoch is still chosen on artists' rigs. ``proportion_variants``: the
+    landmark network also trains on that many reshaped copies
+    (:mod:`.proportions`) of each training character with key joints.
     """
     spec = rig_network(network)
     record = start_run(spec, seed=seed, device=device, epochs=epochs, learning_rate=learning_rate,
@@ -279,7 +283,16 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     if network == "joints":
         weights = train_joint_network(train, holdout, record)
     elif network == "landmarks":
-        by_name = {sample.name: sample for sample in list(samples) + list(procedural_made)}
+        # Other proportions (short legs, big heads) of the trained characters with key joints, as more copies of
+        # each. Not of the rest: with every character reshaped, more validation bipeds were read as "other".
+        trained_names = set(trained)
+        with_landmarks = [sample for sample in samples
+                          if sample.name in trained_names and sample_landmarks(sample)[1].any()]
+        reproportioned = reshaped_variants(with_landmarks, seed, proportion_variants)
+        variants = build_examples(reproportioned, folder / "proportions", seed, variants=0)
+        train += [example for name in sorted(variants) for example in variants[name]]
+        record.details.update(train_examples=len(train), proportion_variants=len(reproportioned))
+        by_name = {sample.name: sample for sample in list(samples) + list(procedural_made) + reproportioned}
         weights = train_landmark_network(by_name, train, holdout, record)
     else:
         weights = train_connectivity_network(spec, train, holdout, record)
