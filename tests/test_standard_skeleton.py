@@ -7,26 +7,22 @@ from autorig_addon.core.dataset.normalise import normalise
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
-from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.rigging.metarig import metarig_placement
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
     FREE_FORM,
-    INSIDE_LIMB_LANDMARKS,
     QUADRUPED,
     SYMMETRIC_PAIR_DISTANCE,
     Landmarks,
     biped_skeleton,
     landmark_warnings,
-    limb_joints_inside,
     quadruped_skeleton,
     symmetrised,
 )
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.skeleton.naming import mirror_name
 from autorig_addon.core.types import Skeleton
-from geometry_fixtures import box_mesh
 
 BIPED_BONES = {
     "spine", "spine.001", "spine.002", "spine.003", "neck", "head",
@@ -196,23 +192,3 @@ def test_warnings_name_key_joints_outside_the_body_and_a_leg_out_of_order():
     )
     quadruped = landmark_warnings(landmarks, QUADRUPED, inside)
     assert quadruped[0] == "check the skeleton: the left front ankle could not be placed inside the body"
-
-
-def test_a_limb_joint_outside_the_body_goes_to_the_nearest_point_inside_and_the_trunk_joints_stay():
-    """A box 1 tall as the body: an elbow put 0.1 above its top goes straight
-    down into it; the hips left as far out stay where the network put them;
-    a knee already inside does not move."""
-    body = box_mesh([-0.2, -0.1, 0.0], [0.2, 0.1, 1.0], 0.05)
-    solid = solid_depth(body, 48)
-    points = {name: np.array([0.0, 0.0, 0.5]) for name in LANDMARKS}
-    points["elbow.L"] = np.array([0.1, 0.0, 1.1])
-    points["hips"] = np.array([0.0, 0.0, 1.1])
-    moved = limb_joints_inside(Landmarks(points, {"biped": 1.0, "quadruped": 0.0, "other": 0.0}), solid)
-    elbow = moved.points["elbow.L"]
-    assert solid.at(elbow[None])[0] >= solid.cell_size
-    np.testing.assert_allclose(elbow[:2], [0.1, 0.0], atol=solid.cell_size)
-    # The surface voxels, one deep, reach half a voxel past the surface.
-    assert 1.0 - 2.5 * solid.cell_size <= elbow[2] <= 1.0 + solid.cell_size
-    np.testing.assert_array_equal(moved.points["hips"], points["hips"])
-    np.testing.assert_array_equal(moved.points["knee.R"], points["knee.R"])
-    assert set(INSIDE_LIMB_LANDMARKS) == {"elbow", "wrist", "knee", "ankle"}

@@ -58,7 +58,6 @@ from .standard_skeleton import (
     faces_backward,
     half_turned,
     landmark_warnings,
-    limb_joints_inside,
     predict_landmarks,
     standard_confidence,
     standard_skeleton,
@@ -235,9 +234,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     if not votes.symmetric:
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
-    # The readings above chose the frame; the skeleton gets limb joints inside the body.
-    return replace(votes, notes=tuple(notes), landmarks=limb_joints_inside(landmarks, solid),
-                   proxy_vertices=graph.vertices,
+    return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
                    surface=Mesh(apply_transform(surface.vertices, transform), surface.triangles))
 
 

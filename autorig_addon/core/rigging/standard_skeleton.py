@@ -43,7 +43,7 @@ from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
-from .joint_features import VERTEX_VECTORS, JointGraph, SolidDepth
+from .joint_features import VERTEX_VECTORS, JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
 
@@ -72,14 +72,6 @@ TAIL_BONES = 3
 MIN_TAIL_LENGTH = 0.08
 #: A hand is this share of its forearm's length when the mesh does not say.
 HAND_SHARE = 0.4
-#: Key joints inside a limb, from its middle joint outward, which
-#: :func:`limb_joints_inside` moves into the body's solid. The trunk's
-#: (hips, neck, head) and the limbs' roots (shoulders, hip joints) are left as
-#: the network places them: they sit between the legs or where a limb meets the
-#: trunk, where the nearest point inside may belong to another part. On every
-#: third training character, moving every key joint put 0.8 % fewer of the
-#: humanoids' right (hips moved into a thigh); moving these four, 0.2 % more.
-INSIDE_LIMB_LANDMARKS = ("elbow", "wrist", "knee", "ankle")
 
 
 @dataclass(frozen=True)
@@ -113,24 +105,6 @@ def predict_landmarks(graph: JointGraph, weights: dict | None = None) -> Landmar
     probabilities /= probabilities.sum()
     return Landmarks({name: np.asarray(points[index], dtype=np.float64) for index, name in enumerate(LANDMARKS)},
                      {kind: float(probabilities[index]) for index, kind in enumerate(BODY_KINDS)})
-
-
-def limb_joints_inside(landmarks: Landmarks, solid: SolidDepth) -> Landmarks:
-    """``landmarks`` with each of :data:`INSIDE_LIMB_LANDMARKS` that lies less
-    than one voxel deep in the body's solid moved to the nearest voxel centre
-    at least one voxel deep: an elbow the network put in the air above a thin
-    T-posed arm goes down into the arm."""
-    names = [name for name in landmarks.points if name.split(".")[0] in INSIDE_LIMB_LANDMARKS]
-    points = np.array([landmarks.points[name] for name in names])
-    outside = solid.at(points) < solid.cell_size
-    inside = np.argwhere(solid.depth >= solid.cell_size)
-    if not outside.any() or not len(inside):
-        return landmarks
-    centres = solid.origin + (inside + 0.5) * solid.cell_size
-    moved = dict(landmarks.points)
-    for name, point in zip(np.array(names)[outside], points[outside]):
-        moved[name] = centres[np.argmin(((centres - point) ** 2).sum(axis=1))]
-    return replace(landmarks, points=moved)
 
 
 def symmetrised(points: dict, symmetric_shape: bool) -> dict:
