@@ -88,6 +88,8 @@ def proportion_variant(sample: CharacterSample, number: int, seed: int) -> Chara
     vertices, joints, tails = (reproportioned(points, height, heights, widths)
                                for points in (sample.vertices, sample.joints, sample.tails))
     transform = normalisation_transform(vertices)
+    # The reshaping is no similarity: ``transform`` then maps the source file's space to the variant only roughly,
+    # kept for the normalisation's scale and shift; training reads the variant's own arrays.
     return replace(sample, name=f"{sample.name}{VARIANT_MARK}{number}", vertices=apply_transform(vertices, transform),
                    joints=apply_transform(joints, transform), tails=apply_transform(tails, transform),
                    transform=transform @ sample.transform)

@@ -288,11 +288,11 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
         trained_names = set(trained)
         with_landmarks = [sample for sample in samples
                           if sample.name in trained_names and sample_landmarks(sample)[1].any()]
-        reproportioned = reshaped_variants(with_landmarks, seed, proportion_variants)
-        variants = build_examples(reproportioned, folder / "proportions", seed, variants=0)
+        reshaped = reshaped_variants(with_landmarks, seed, proportion_variants)
+        variants = build_examples(reshaped, folder / "proportions", seed, variants=0)
         train += [example for name in sorted(variants) for example in variants[name]]
-        record.details.update(train_examples=len(train), proportion_variants=len(reproportioned))
-        by_name = {sample.name: sample for sample in list(samples) + list(procedural_made) + reproportioned}
+        record.details.update(train_examples=len(train), proportion_variants=len(reshaped))
+        by_name = {sample.name: sample for sample in list(samples) + list(procedural_made) + reshaped}
         weights = train_landmark_network(by_name, train, holdout, record)
     else:
         weights = train_connectivity_network(spec, train, holdout, record)
