@@ -52,12 +52,6 @@ MAX_INFLUENCES = 2
 #: Seed and kind of the generated character (2,150 vertices, 24 deform bones).
 CHARACTER_SEED, CHARACTER_KIND = 3, "biped"
 #: What every refusal of an unknown method says.
-#: The methods that weight a two-bone skeleton (RigNet's network needs as
-#: many deform bones as it has candidates, its spec's min_deform_bones).
-TWO_BONE_METHODS = tuple(m for m in SKIN_METHODS if m not in SKIN_NETWORKS or SKIN_NETWORKS[m].min_deform_bones <= 2)
-TWO_BONE_NETWORKS = tuple(m for m in NETWORK_NAMES if m in TWO_BONE_METHODS)
-RIGNET_TOO_FEW_BONES = ("rignet needs at least 3 deform bones and the armature has 2: use heterskinnet, skinningnet "
-                        "or geometric for so small a skeleton.")
 UNKNOWN_METHOD = "Unknown skinning method 'magic': use one of geometric, rignet, heterskinnet, skinningnet."
 
 
@@ -130,13 +124,18 @@ def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(networ
     np.testing.assert_array_equal(rigid.matrix, expected)
 
 
-def test_rignet_refuses_a_skeleton_smaller_than_its_candidate_set():
-    assert TWO_BONE_METHODS == ("geometric", "heterskinnet", "skinningnet")
-    with pytest.raises(InputError, match=f"^{re.escape(RIGNET_TOO_FEW_BONES)}$"):
-        skin_weights(tube(), two_bone_skeleton(TUBE_HEIGHT), SkinningOptions("rignet", resolution=RESOLUTION))
+def test_rignet_weights_a_skeleton_smaller_than_it_needs_through_cut_bones():
+    # RigNet needs 3 deform bones: it sees the two cut in two each, and each
+    # bone gets the sum of its halves.
+    assert SKIN_NETWORKS["rignet"].min_deform_bones == 3
+    mesh = tube()
+    weights = skin_weights(mesh, two_bone_skeleton(TUBE_HEIGHT), SkinningOptions("rignet", resolution=RESOLUTION))
+    assert weights.bone_names == two_bone_skeleton(TUBE_HEIGHT).names
+    assert_valid_weights(weights.matrix, geometric.DEFAULT_MAX_INFLUENCES)
+    assert_ends_on_their_bones(weights.matrix, mesh.vertices[:, 2])
 
 
-@pytest.mark.parametrize("method", TWO_BONE_METHODS)
+@pytest.mark.parametrize("method", SKIN_METHODS)
 def test_each_method_sends_each_end_of_a_two_bone_tube_to_its_bone(method):
     mesh = tube()
     weights = skin_weights(mesh, two_bone_skeleton(TUBE_HEIGHT), SkinningOptions(method, resolution=RESOLUTION))
@@ -260,7 +259,7 @@ def test_the_panels_and_operators_method_items_and_default_are_the_cores(clean_s
         assert method.default == DEFAULT_SKIN_METHOD.upper()
 
 
-@pytest.mark.parametrize("network", TWO_BONE_NETWORKS)
+@pytest.mark.parametrize("network", NETWORK_NAMES)
 def test_operator_skins_the_tube_with_each_network(clean_scene, capfd, network):
     import bpy
 
@@ -302,18 +301,6 @@ def test_no_deform_bones_with_a_network_is_refused_and_the_scene_unchanged(clean
     message = "The armature 'Armature' has no deform bones: enable Deform on the bones to weight."
     with pytest.raises(RuntimeError, match=f"^Error: {re.escape(message)}\n$"):
         bpy.ops.autorig.skin_weights(skin_method=network.upper(), skin_resolution=RESOLUTION)
-    assert scene_state([armature, body]) == before
-
-
-def test_rignet_on_a_two_bone_armature_is_refused_and_the_scene_unchanged(clean_scene):
-    import bpy
-
-    from blender_fixtures import scene_state
-
-    armature, body = tube_scene()
-    before = scene_state([armature, body])
-    with pytest.raises(RuntimeError, match=f"^Error: {re.escape(RIGNET_TOO_FEW_BONES)}\n$"):
-        bpy.ops.autorig.skin_weights(skin_method="RIGNET", skin_resolution=RESOLUTION)
     assert scene_state([armature, body]) == before
 
 
@@ -402,7 +389,7 @@ def saved_scene(path, deform=True):
     return path
 
 
-@pytest.mark.parametrize("network", TWO_BONE_NETWORKS)
+@pytest.mark.parametrize("network", NETWORK_NAMES)
 def test_skin_command_skins_the_tube_with_each_network(clean_scene, tmp_path, capsys, network):
     import bpy
 

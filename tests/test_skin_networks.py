@@ -31,13 +31,13 @@ def test_dense_weights_spread_the_candidates_into_bone_columns():
     np.testing.assert_allclose(predict.dense_weights(chain, candidate), [[0.7, 0.3], [0.4, 0.6], [0.5, 0.5]])
 
 
-def test_finished_weights_limit_prune_and_normalise():
+def test_pruned_weights_limit_prune_and_normalise():
     weights = np.zeros((4, 40))
     weights[0, :5] = [0.5, 0.3, 0.1, 0.06, 0.04]
     weights[1, :5] = [0.4, 0.3, 0.26, 0.02, 0.02]
     weights[2, :2] = [predict.PRUNE_BELOW, 1 - predict.PRUNE_BELOW]
     weights[3] = 0.025  # every weight below PRUNE_BELOW (0.08): the largest (the first) is kept
-    finished = predict.finished_weights(weights, max_influences=4)
+    finished = predict.pruned_weights(weights, max_influences=4)
     # Row 0: the 5th weight is cut by the limit, then the 4th (0.06 / 0.96) by pruning.
     np.testing.assert_allclose(finished[0, :5], np.array([0.5, 0.3, 0.1, 0, 0]) / 0.9)
     # Row 1: one 0.02 is cut by the limit, the other (0.02 / 0.98) by pruning.
@@ -47,11 +47,24 @@ def test_finished_weights_limit_prune_and_normalise():
     # Row 3: the limit keeps 4 of the equal weights (0.25 each, above the threshold).
     assert (finished[3] > 0).sum() == 4
     np.testing.assert_allclose(finished[3][finished[3] > 0], 0.25)
-    unlimited = predict.finished_weights(weights, max_influences=0)
+    unlimited = predict.pruned_weights(weights, max_influences=0)
     np.testing.assert_allclose(unlimited[3], np.eye(40)[0])
     for result in (finished, unlimited):
         np.testing.assert_allclose(result.sum(axis=1), 1)
         assert (result[:, :] >= 0).all()
+
+
+def test_finished_weights_are_the_pruned_ones_sharpened():
+    weights = np.zeros((2, 6))
+    weights[0, :3] = [0.6, 0.3, 0.1]
+    weights[1, :2] = [0.5, 0.5]
+    finished = predict.finished_weights(weights, max_influences=4)
+    # Nothing is pruned (all above 0.08); 0.6 : 0.3 : 0.1 becomes 0.6 ** 1.25 : 0.3 ** 1.25 : 0.1 ** 1.25.
+    assert predict.SHARPEN_POWER == 1.25
+    powered = np.array([0.6, 0.3, 0.1]) ** 1.25
+    np.testing.assert_allclose(finished[0, :3], powered / powered.sum())
+    assert finished[0, 0] > 0.6 and finished[0, 2] < 0.1
+    np.testing.assert_allclose(finished[1, :2], [0.5, 0.5])  # an even blend stays even
 
 
 def test_learned_weights_refuse_bad_input():
@@ -86,14 +99,22 @@ def test_learned_weights_of_a_procedural_character(name):
     assert weights.matrix.shape == (sample.mesh.vertex_count, len(sample.deform_names))
     np.testing.assert_allclose(weights.matrix.sum(axis=1), 1, atol=1e-12)
     assert (weights.matrix >= 0).all() and ((weights.matrix > 0).sum(axis=1) <= 4).all()
-    # A two-bone skeleton (fewer bones than candidates) is weighted as well,
-    # except by RigNet's network, which refuses it (its spec's min_deform_bones).
-    if SKIN_NETWORKS[name].min_deform_bones > 2:
-        with pytest.raises(InputError, match="^rignet needs at least 3 deform bones and the armature has 2"):
-            predict.learned_weights(cylinder(radius=0.1, rings=11), two_bone_skeleton(), name, resolution=RESOLUTION)
-        return
+    # A two-bone skeleton (fewer bones than candidates) is weighted as well
+    # (RigNet's network through cut bones, its spec's min_deform_bones).
     two = predict.learned_weights(cylinder(radius=0.1, rings=11), two_bone_skeleton(), name, resolution=RESOLUTION)
     np.testing.assert_allclose(two.matrix.sum(axis=1), 1, atol=1e-12)
+
+
+def test_split_bones_cuts_each_deform_bone_into_a_chain_of_equal_pieces():
+    skeleton = Skeleton(np.array([[0, 0, 0.0], [0, 0, 1.0], [0.5, 0, 1.0]]), np.array([-1, 0, 1]),
+                        ("lower", "upper", "prop"), np.array([[0, 0, 1.0], [0, 0, 2.0], [0.6, 0, 1.0]]),
+                        np.array([True, True, False]))
+    cut, owner = predict.split_bones(skeleton, 2)
+    assert cut.names == ("lower#0", "lower#1", "upper#0", "upper#1")
+    np.testing.assert_array_equal(cut.parents, [-1, 0, 1, 2])
+    np.testing.assert_allclose(cut.joints[:, 2], [0.0, 0.5, 1.0, 1.5])
+    np.testing.assert_allclose(cut.tails[:, 2], [0.5, 1.0, 1.5, 2.0])
+    np.testing.assert_array_equal(owner, [0, 0, 1, 1])
 
 
 #: Largest L1 difference between the weights of two vertices joined by a
@@ -120,11 +141,11 @@ def test_learned_weights_of_a_big_mesh_run_on_a_proxy_and_come_back_smoothly():
     assert np.percentile(jumps, 99) < SMOOTH_CARRY_P99_JUMP
 
 
-@pytest.mark.parametrize("name", ["heterskinnet", "skinningnet"])
+@pytest.mark.parametrize("name", NETWORK_NAMES)
 def test_several_objects_a_loose_prop_and_a_bone_outside_the_body_are_all_weighted(name):
     # A tube (two bones inside), a loose box prop floating beside it, and a
     # third bone in the air above the tube: every vertex of both objects gets
-    # a full row, and the tube's lower end keeps its own bone (RigNet refuses three bones).
+    # a full row, and the tube's lower end keeps its own bone.
     tube = cylinder(radius=0.1, height=2.0, rings=21)
     prop = box_mesh([0.4, -0.1, 1.6], [0.6, 0.1, 1.8], 0.05)
     mesh = Mesh.concatenate([Mesh(tube.vertices, tube.triangles, object_names=("Tube",)),

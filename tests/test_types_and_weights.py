@@ -12,6 +12,7 @@ from autorig_addon.core.weights import (
     mix_weights,
     normalize_rows,
     prune_small,
+    sharpened,
     usable_rows,
 )
 
@@ -116,6 +117,15 @@ def test_limit_influences_keeps_the_largest_and_renormalises():
 def test_prune_small_drops_negligible_entries():
     out = prune_small(np.array([[1.0, 5e-5, 0.0], [0.0, 0.0, 0.0]]))
     np.testing.assert_allclose(out, [[1, 0, 0], [0, 0, 0]])
+
+
+def test_sharpened_narrows_a_blend_and_keeps_zeros_and_empty_rows():
+    raw = np.array([[0.8, 0.2, 0.0], [0.5, 0.5, 0.0], [0.0, 0.0, 0.0]])
+    # 0.8 ** 2 = 0.64 and 0.2 ** 2 = 0.04: the blend narrows from 80/20 to 94/6.
+    np.testing.assert_allclose(sharpened(raw, 2.0), [[0.64 / 0.68, 0.04 / 0.68, 0], [0.5, 0.5, 0], [0, 0, 0]])
+    np.testing.assert_allclose(sharpened(raw * 3.0, 1.0), raw)
+    with pytest.raises(ValueError, match="positive, got 0"):
+        sharpened(raw, 0.0)
 
 
 def test_mix_changes_only_the_chosen_columns():

@@ -105,6 +105,16 @@ def prune_small(weights: np.ndarray, threshold: float = INFLUENCE_EPSILON) -> np
     return normalize_rows(np.where(keep, weights, 0.0))
 
 
+def sharpened(weights: np.ndarray, power: float) -> np.ndarray:
+    """Each weight raised to ``power`` and the rows renormalised: above 1 a
+    row's largest weights gain on its small ones (a blend narrows), zeros
+    stay zero, and every row keeps its order of bones."""
+    if power <= 0.0:
+        raise ValueError(f"The sharpening power must be positive, got {power}.")
+    weights = normalize_rows(weights)
+    return weights if power == 1.0 else normalize_rows(weights ** power)
+
+
 def mix_weights(existing: np.ndarray, incoming: np.ndarray, factor: float,
                 columns: np.ndarray | None = None) -> np.ndarray:
     """Blend ``incoming`` into ``existing`` by ``factor`` in [0, 1].

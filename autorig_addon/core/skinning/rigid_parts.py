@@ -16,31 +16,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.normals import triangle_double_areas
+from ..geometry.laplacian import voronoi_mass
 from ..geometry.topology import connected_component_labels
 from ..geometry.weld import weld_mesh
 from ..types import Mesh
 
 #: A loose part whose area-weighted weights hold at least this share on one
 #: bone is bound wholly to it (see :func:`rigid_weights`). Chosen on every
-#: third training character under HeterSkinNet (2026-11-26): from 0.75 to 0.9
-#: the deformation error is the lowest and equal, L1 falls to 0.9; 0.85 keeps
-#: more of the artists' influences (recall) than 0.75 and more precision than 0.9.
-RIGID_SHARE = 0.85
+#: third training character under HeterSkinNet's finished weights (sharpened,
+#: ``..learned.predict.SHARPEN_POWER``; 2026-11-26): L1 0.4049, 0.4041,
+#: 0.4042, 0.4045, 0.4012, 0.4018 at 0.7, 0.75, 0.8, 0.85, 0.9, 0.95 (0.4066
+#: without), the deformation error lowest and equal from 0.75 to 0.95, recall
+#: rising with the share (0.736 at 0.9, 0.728 at 0.85), precision falling
+#: (0.831 and 0.835).
+RIGID_SHARE = 0.9
 
 
 def loose_parts(mesh: Mesh) -> np.ndarray:
     """(n,) int label of each vertex's loose part, UV seams joined first."""
     welded, to_welded = weld_mesh(mesh)
     return connected_component_labels(welded.triangles, welded.vertex_count)[to_welded]
-
-
-def vertex_areas(mesh: Mesh) -> np.ndarray:
-    """(n,) a third of the area of each vertex's triangles (0 for a vertex in none)."""
-    areas = np.zeros(mesh.vertex_count)
-    np.add.at(areas, mesh.triangles.reshape(-1), np.repeat(triangle_double_areas(mesh.vertices, mesh.triangles) / 6.0,
-                                                           3))
-    return areas
 
 
 def rigid_weights(mesh: Mesh, weights: np.ndarray, share: float = RIGID_SHARE) -> tuple[np.ndarray, int]:
@@ -65,7 +60,7 @@ def rigid_weights(mesh: Mesh, weights: np.ndarray, share: float = RIGID_SHARE) -
     weighted = (weights > 0).any(axis=1)
     mass = np.zeros((count, weights.shape[1]))
     # Area-weighted, so a finely tessellated corner does not outvote the rest of the part.
-    np.add.at(mass, labels, weights * np.maximum(vertex_areas(mesh), 1e-30)[:, None])
+    np.add.at(mass, labels, weights * np.maximum(voronoi_mass(mesh.vertices, mesh.triangles), 1e-30)[:, None])
     totals = mass.sum(axis=1)
     bone = mass.argmax(axis=1)
     rigid = (totals > 0) & (mass[np.arange(count), bone] >= share * totals)

@@ -19,8 +19,9 @@ Steps, for a mesh and any armature (one an artist edited included):
 5. Back on the original mesh (interpolated at each vertex's closest point
    on the proxy surface, so no blocky seams), and last: at most
    ``max_influences`` bones per vertex, weights at or below
-   :data:`PRUNE_BELOW` dropped, rows normalised. Every row keeps at least
-   its largest weight, so no vertex is left unweighted.
+   :data:`PRUNE_BELOW` dropped, the rest raised to :data:`SHARPEN_POWER`,
+   rows normalised. Every row keeps at least its largest weight, so no
+   vertex is left unweighted.
 """
 
 from __future__ import annotations
@@ -31,17 +32,16 @@ from ...dataset.normalise import normalise
 from ...distances.grid import DEFAULT_RESOLUTION
 from ...distances.hollow_dist import hollow_distances
 from ...distances.volumetric_geodesic import volumetric_geodesic_distances
-from ...errors import InputError
 from ...geometry.proxy import simplified_proxy
 from ...nn.numpy_kernels import NUMPY
 from ...nn.spec import shipped_weights
 from ...progress import ProgressCallback, report, sub_progress
 from ...types import Mesh, Skeleton, Weights
-from ...weights import limit_influences, prune_small
+from ...weights import limit_influences, prune_small, sharpened
 from ..geometric import DEFAULT_MAX_INFLUENCES, deform_bones_of, geometric_weights
 from ..heat_prior import heat_prior_weights
 from .features import SkinGraph, skin_graph
-from .networks import SKIN_NETWORKS, skin_network
+from .networks import skin_network
 from .networks.scoring import PRIOR_KINDS, SkinNetworkSpec, candidate_weights
 
 #: Vertices of the proxy the networks see: the training characters' count
@@ -57,6 +57,17 @@ NETWORK_PROXY_VERTICES = 3_000
 #: ``docs/models.md``). The networks trained on more varied artists spread
 #: their weights more, so more small ones are noise.
 PRUNE_BELOW = 0.08
+#: The kept weights are raised to this power and renormalised: the networks
+#: blend wider than artists do (a softmax over a graph of the mesh), and a
+#: slightly narrower blend is nearer theirs. Chosen with
+#: :data:`PRUNE_BELOW` on the same held-out training characters
+#: (``scripts/tune_skin_pruning.py``, 2026-11-26): at 0.08, L1 1.0 -> 1.25
+#: -> 1.5 -> 2.0: HeterSkinNet 0.4273, 0.4199, 0.4231, 0.4413; RigNet
+#: 0.4811, 0.4767, 0.4820, 0.5021; SkinningNet 0.4442, 0.4317, 0.4299,
+#: 0.4430. One power for all three, each within 0.002 of its own best
+#: (HeterSkinNet 0.4186 at 0.05 and 1.25, SkinningNet 0.4299 at 0.08 and
+#: 1.5); precision and recall do not change (the same influences).
+SHARPEN_POWER = 1.25
 
 
 def network_graph(mesh: Mesh, skeleton: Skeleton, distance: str, *, prior: str = "geometric",
@@ -103,10 +114,46 @@ def dense_weights(graph: SkinGraph, candidate: np.ndarray) -> np.ndarray:
     return dense
 
 
-def finished_weights(weights: np.ndarray, max_influences: int) -> np.ndarray:
-    """The last step on the full mesh: influence limit, pruning at
-    :data:`PRUNE_BELOW`, rows normalised."""
+def pruned_weights(weights: np.ndarray, max_influences: int) -> np.ndarray:
+    """Influence limit and pruning at :data:`PRUNE_BELOW`, rows normalised:
+    what training scores its held-out characters on to keep an epoch (the
+    shipped networks' epochs were kept so, before :data:`SHARPEN_POWER` was
+    chosen)."""
     return prune_small(limit_influences(weights, max_influences), PRUNE_BELOW)
+
+
+def finished_weights(weights: np.ndarray, max_influences: int) -> np.ndarray:
+    """The last step on the full mesh: :func:`pruned_weights`, then
+    sharpened by :data:`SHARPEN_POWER`."""
+    return sharpened(pruned_weights(weights, max_influences), SHARPEN_POWER)
+
+
+def split_bones(skeleton: Skeleton, pieces: int) -> tuple[Skeleton, np.ndarray]:
+    """The deform bones of ``skeleton``, each cut into ``pieces`` equal bones
+    chained head to tail, for a network that needs more bones than the
+    armature has (:data:`.networks.scoring.SkinNetworkSpec.min_deform_bones`).
+
+    Returns
+    -------
+    (skeleton, owner): the cut skeleton (deform bones only, each piece named
+    ``BONE#k``, its first piece parented to the last piece of the bone's
+    nearest deforming ancestor) and, per piece, the index of its bone among
+    the deform bones, to sum the pieces' weights back onto it.
+    """
+    deform = skeleton.deform_subset()
+    steps = np.arange(pieces + 1)[:, None] / pieces
+    joints, tails, parents, names, owner = [], [], [], [], []
+    for bone in range(deform.bone_count):
+        points = deform.joints[bone] + steps * (deform.tails[bone] - deform.joints[bone])
+        parent = deform.parents[bone]
+        for piece in range(pieces):
+            parents.append(pieces * parent + pieces - 1 if piece == 0 and parent >= 0 else
+                           len(joints) - 1 if piece else -1)
+            joints.append(points[piece])
+            tails.append(points[piece + 1])
+            names.append(f"{deform.names[bone]}#{piece}")
+            owner.append(bone)
+    return Skeleton(np.array(joints), np.array(parents), tuple(names), np.array(tails)), np.array(owner)
 
 
 def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influences: int = DEFAULT_MAX_INFLUENCES,
@@ -128,26 +175,34 @@ def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influen
     Weights with one column per deform bone (in skeleton order); every row
     is non-negative, sums to 1 and has at most ``max_influences`` non-zeros.
 
+    A network that weights no fewer than ``min_deform_bones`` bones (RigNet:
+    3) sees a smaller skeleton with each bone cut into equal pieces
+    (:func:`split_bones`), and each bone gets the sum of its pieces' weights.
+
     Raises
     ------
     InputError for an unknown network, no deform bones or no vertices.
     """
     spec = skin_network(network)
     deform = deform_bones_of(mesh, skeleton)
+    owner = None
     if len(deform) < spec.min_deform_bones:
-        takers = [name for name, other in SKIN_NETWORKS.items() if other.min_deform_bones <= len(deform)]
-        raise InputError(
-            f"{network} needs at least {spec.min_deform_bones} deform bones and the armature has {len(deform)}: "
-            f"use {', '.join(takers)} or geometric for so small a skeleton.")
+        skeleton_seen, owner = split_bones(skeleton, -(-spec.min_deform_bones // len(deform)))
+    else:
+        skeleton_seen = skeleton
     shipped_weights(spec)  # a missing file fails before the long work
     report(progress, 0.0, "Welding and simplifying the mesh")
     proxy = simplified_proxy(mesh, NETWORK_PROXY_VERTICES)
-    normalised = normalise(proxy.mesh, skeleton)
+    normalised = normalise(proxy.mesh, skeleton_seen)
     graph = network_graph(normalised.mesh, normalised.skeleton, spec.distance, prior=spec.prior,
                           resolution=resolution,
                           progress=sub_progress(progress, 0.05, 0.9))
     report(progress, 0.9, f"Running {network}")
     weights = dense_weights(graph, network_candidate_weights(spec, graph))
+    if owner is not None:
+        summed = np.zeros((len(weights), len(deform)))
+        np.add.at(summed.T, owner, weights.T)
+        weights = summed
     report(progress, 0.95, "Carrying the weights to every vertex")
     weights = proxy.carry(weights, lambda rows, carried: finished_weights(carried, max_influences))
     report(progress, 1.0, "Weights done")

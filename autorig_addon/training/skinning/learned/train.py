@@ -36,7 +36,7 @@ from ....core.skinning.geometric import DEFAULT_MAX_INFLUENCES
 from ....core.skinning.learned.features import BONE_VECTORS, PAIR_VECTORS, VERTEX_VECTORS, SkinGraph
 from ....core.skinning.learned.networks import skin_network
 from ....core.skinning.learned.networks.scoring import SkinNetworkSpec, candidate_weights
-from ....core.skinning.learned.predict import dense_weights, finished_weights, network_candidate_weights
+from ....core.skinning.learned.predict import dense_weights, network_candidate_weights, pruned_weights
 from ...nn.augmentation import turn_and_mirror, turned_columns
 from ...nn.fit import FitRecord, Log, fit, log_to_stderr
 from ...nn.modules import NetworkModule, as_tensors
@@ -85,7 +85,7 @@ def holdout_scores(spec: SkinNetworkSpec, weights: dict, holdout: list) -> dict:
     l1s, precisions, recalls = [], [], []
     for graph, reference in holdout:
         candidate = network_candidate_weights(spec, graph, weights)
-        predicted = finished_weights(dense_weights(graph, candidate), DEFAULT_MAX_INFLUENCES)
+        predicted = pruned_weights(dense_weights(graph, candidate), DEFAULT_MAX_INFLUENCES)
         l1s.append(skin_l1(predicted, reference))
         scores = influence_precision_recall(predicted, reference)
         precisions.append(scores["precision"])

@@ -8,9 +8,9 @@ bones than candidates leaves empty input slots. The 419-character split's
 training set holds 20 characters of 2 to 4 deform bones, so it has learned
 3 and 4 (a three-bone tube: 0.955 of each bone's middle on that bone, as
 good as the other networks), but two bones still defeat it (0.65 of a
-two-bone tube's upper band on its bone, the others 0.93 to 1.0): it
-refuses fewer than 3 deform bones (it refused fewer than 5 when no training
-character had so few).
+two-bone tube's upper band on its bone, the others 0.93 to 1.0): on fewer
+than 3 deform bones it sees each bone cut into pieces
+(``..predict.split_bones``).
 """
 
 from __future__ import annotations
