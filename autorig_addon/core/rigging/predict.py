@@ -42,6 +42,7 @@ from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
+from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .orientation import stand_upright
@@ -229,6 +230,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y (turned, it reads as a {landmarks.kind}); it was turned half "
                      "a turn for the prediction, so its .L bones lie on its own left.")
+    landmarks, leg_notes = _short_legs_read_again(proxy, transform, solid, landmarks, graph.vertices)
+    notes += leg_notes
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
@@ -236,6 +239,26 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
                    surface=Mesh(apply_transform(surface.vertices, transform), surface.triangles))
+
+
+def _short_legs_read_again(proxy: Mesh, transform: np.ndarray, solid: SolidDepth, landmarks: Landmarks,
+                           normalised_vertices: np.ndarray) -> tuple[Landmarks, tuple]:
+    """A biped's landmarks read again on its body stretched to typical leg
+    length when they put its hip joints far above its crotch
+    (:mod:`.leg_length`), mapped back; else ``landmarks`` as they are. Also
+    the note saying so."""
+    if landmarks.kind != BIPED or landmarks.confidence < KIND_CONFIDENCE:
+        return landmarks, ()
+    top = float(normalised_vertices[:, 2].max())
+    height_map = short_leg_map(landmarks.points, solid, top)
+    if height_map is None:
+        return landmarks, ()
+    normalised = Mesh(apply_transform(proxy.vertices, transform), proxy.triangles)
+    body, stretch = stretched(normalised, height_map)
+    reread = predict_landmarks(joint_graph(body, solid_depth(body)))
+    note = (f"The legs are short (crotch at {height_map.crotch / top:.0%} of the height) and were first read as "
+            f"longer: the landmarks were read again on the body stretched to a crotch at {TYPICAL_CROTCH_SHARE:.0%}.")
+    return replace(reread, points=points_back(reread.points, stretch, height_map)), (note,)
 
 
 def framed_transform(vertices: np.ndarray, rotation: np.ndarray) -> np.ndarray:
