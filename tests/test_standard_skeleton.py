@@ -12,10 +12,13 @@ from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
     FREE_FORM,
+    MAX_NECK_LENGTH,
     QUADRUPED,
     SYMMETRIC_PAIR_DISTANCE,
     Landmarks,
     biped_skeleton,
+    head_near_neck,
+    hips_at_most_at_hip_joints,
     landmark_warnings,
     quadruped_skeleton,
     symmetrised,
@@ -117,6 +120,29 @@ def test_landmarks_are_mirrored_on_a_nearly_symmetric_shape_and_near_twins_on_an
     np.testing.assert_allclose(symmetric["wrist.L"], [0.3, 0.0, 0.6])
     np.testing.assert_allclose(symmetric["wrist.R"], [-0.3, 0.0, 0.6])
     assert symmetric["hips"][0] == 0.0
+
+
+def test_a_bipeds_hips_come_down_to_its_hip_joints_never_up():
+    points = {"hips": np.array([0.0, 0.01, 0.55]), "hip.L": np.array([0.1, 0.0, 0.46]),
+              "hip.R": np.array([-0.1, 0.0, 0.48])}
+    lowered = hips_at_most_at_hip_joints(points)
+    # To the middle of the hip joints' heights (0.47), in place across and along.
+    np.testing.assert_allclose(lowered["hips"], [0.0, 0.01, 0.47])
+    np.testing.assert_array_equal(lowered["hip.L"], points["hip.L"])
+    assert points["hips"][2] == 0.55  # the caller's landmarks are left as they were
+    below = dict(points, hips=np.array([0.0, 0.01, 0.42]))
+    np.testing.assert_array_equal(hips_at_most_at_hip_joints(below)["hips"], [0.0, 0.01, 0.42])
+
+
+def test_a_bipeds_head_joint_is_drawn_toward_its_neck_to_a_neck_length():
+    assert MAX_NECK_LENGTH == 0.0525
+    points = {"neck": np.array([0.0, 0.0, 0.8]), "head": np.array([0.0, 0.06, 0.88])}  # 0.1 from the neck
+    drawn = head_near_neck(points)
+    # Along the line from the neck: 0.0525 of (0.06, 0.08) / 0.1.
+    np.testing.assert_allclose(drawn["head"], [0.0, 0.0315, 0.842])
+    np.testing.assert_array_equal(drawn["neck"], points["neck"])
+    short = dict(points, head=np.array([0.0, 0.0, 0.84]))
+    np.testing.assert_array_equal(head_near_neck(short)["head"], [0.0, 0.0, 0.84])
 
 
 def votes_with(kind_probabilities):
