@@ -1,8 +1,8 @@
 """Short legs read again: the landmark network on a biped stretched to typical leg length.
 
 The landmark network (:mod:`.networks.landmarks`) learnt bodies whose crotch
-sits at 32 to 52 % of their height (the training families' medians; 0 A.D.'s
-humans, most of them, at 43 %). On a short-legged, big-headed character
+sits mostly at 32 to 52 % of their height (the training families' medians;
+0 A.D.'s humans, most of them, at 43 %; KayKit's three at 16 %). On a short-legged, big-headed character
 (Quaternius' animated and monster packs, crotch at 19 to 31 %) it lays the
 trunk out where those bodies have it: the hips, the hip joints, the
 shoulders and the head 0.1 to 0.2 of the height too high, while the knees
