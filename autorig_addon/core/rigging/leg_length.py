@@ -106,10 +106,7 @@ def stretched(proxy: Mesh, height_map: HeightMap) -> tuple[Mesh, np.ndarray]:
 
 def points_back(points: dict, transform: np.ndarray, height_map: HeightMap) -> dict:
     """Landmarks read on :func:`stretched` mapped back to the body as it is."""
-    inverse = np.linalg.inv(transform)
-    back = {}
-    for name, point in points.items():
-        moved = apply_transform(np.asarray(point, dtype=np.float64)[None], inverse)[0]
-        moved[2] = height_map.inverse(moved[2])
-        back[name] = moved
-    return back
+    names = list(points)
+    moved = apply_transform(np.array([points[name] for name in names], dtype=np.float64), np.linalg.inv(transform))
+    moved[:, 2] = height_map.inverse(moved[:, 2])
+    return dict(zip(names, moved))

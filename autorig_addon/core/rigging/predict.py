@@ -230,7 +230,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y (turned, it reads as a {landmarks.kind}); it was turned half "
                      "a turn for the prediction, so its .L bones lie on its own left.")
-    landmarks, leg_notes = _short_legs_read_again(proxy, transform, solid, landmarks, graph.vertices)
+    landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
@@ -241,21 +241,20 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                    surface=Mesh(apply_transform(surface.vertices, transform), surface.triangles))
 
 
-def _short_legs_read_again(proxy: Mesh, transform: np.ndarray, solid: SolidDepth, landmarks: Landmarks,
-                           normalised_vertices: np.ndarray) -> tuple[Landmarks, tuple]:
-    """A biped's landmarks read again on its body stretched to typical leg
+def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> tuple[Landmarks, tuple]:
+    """A biped's landmarks read again on its body (``normalised``: the proxy
+    in the normalised frame, ``solid`` its solid) stretched to typical leg
     length when they put its hip joints far above its crotch
     (:mod:`.leg_length`), mapped back; else ``landmarks`` as they are. Also
     the note saying so."""
     if landmarks.kind != BIPED or landmarks.confidence < KIND_CONFIDENCE:
         return landmarks, ()
-    top = float(normalised_vertices[:, 2].max())
+    top = float(normalised.vertices[:, 2].max())
     height_map = short_leg_map(landmarks.points, solid, top)
     if height_map is None:
         return landmarks, ()
-    normalised = Mesh(apply_transform(proxy.vertices, transform), proxy.triangles)
     body, stretch = stretched(normalised, height_map)
-    reread = predict_landmarks(joint_graph(body, solid_depth(body)))
+    reread = predict_landmarks(joint_graph(body))
     note = (f"The legs are short (crotch at {height_map.crotch / top:.0%} of the height) and were first read as "
             f"longer: the landmarks were read again on the body stretched to a crotch at {TYPICAL_CROTCH_SHARE:.0%}.")
     return replace(reread, points=points_back(reread.points, stretch, height_map)), (note,)
