@@ -276,8 +276,8 @@ def test_garment_without_source_fails_alone(clean_scene, tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("task", "method", "message"),
-    [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'geometric', 'heterskinnet', "
-                       "'nearest_bone', 'rignet', 'skinningnet', 'reference']."),
+    [("skin", "magic", "Unknown skin method 'magic': use one of ['boneheat', 'ensemble', 'geometric', "
+                       "'heterskinnet', 'nearest_bone', 'rignet', 'skinningnet', 'reference']."),
      ("rig", "file:/no/such/folder", "The folder of predicted rigs '/no/such/folder' does not exist."),
      ("rig", "oracle", "Unknown rig method 'oracle': use file:DIR or one of ['nearest_character', 'rignet', "
                        "'rignet_free_form']."),

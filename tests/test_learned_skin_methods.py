@@ -20,10 +20,17 @@ import pytest
 from autorig_addon.cli import evaluation_methods
 from autorig_addon.cli import skin as cli_skin
 from autorig_addon.core.errors import Cancelled, InputError
+from autorig_addon.core.geometry.proxy import simplified_proxy
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.skinning import geometric
+from autorig_addon.core.skinning.learned.ensemble import ENSEMBLE, ENSEMBLE_MEMBERS
 from autorig_addon.core.skinning.learned.networks import NETWORK_NAMES, SKIN_NETWORKS
-from autorig_addon.core.skinning.learned.predict import learned_weights
+from autorig_addon.core.skinning.learned.predict import (
+    NETWORK_PROXY_VERTICES,
+    finished_weights,
+    learned_weights,
+    proxy_weights,
+)
 from autorig_addon.core.skinning.methods import (
     DEFAULT_SKIN_METHOD,
     GEOMETRIC,
@@ -35,6 +42,9 @@ from autorig_addon.core.skinning.methods import (
 from autorig_addon.core.skinning.options import SkinningOptions, ignored_options
 from autorig_addon.core.skinning.rigid_parts import rigid_weights
 from geometry_fixtures import cylinder, two_bone_skeleton
+
+#: The trained methods: each network and their ensemble.
+LEARNED_METHODS = NETWORK_NAMES + (ENSEMBLE,)
 
 #: Height of the test tube; its two bones meet at half of it.
 TUBE_HEIGHT = 2.0
@@ -52,7 +62,8 @@ MAX_INFLUENCES = 2
 #: Seed and kind of the generated character (2,150 vertices, 24 deform bones).
 CHARACTER_SEED, CHARACTER_KIND = 3, "biped"
 #: What every refusal of an unknown method says.
-UNKNOWN_METHOD = "Unknown skinning method 'magic': use one of geometric, rignet, heterskinnet, skinningnet."
+UNKNOWN_METHOD = ("Unknown skinning method 'magic': use one of geometric, rignet, heterskinnet, skinningnet, "
+                  "ensemble.")
 
 
 def tube():
@@ -78,10 +89,10 @@ def assert_ends_on_their_bones(matrix: np.ndarray, heights: np.ndarray) -> None:
 # --------------------------------------------------------------------------- core: names, dispatcher
 
 
-def test_the_methods_are_the_geometric_one_and_the_networks():
-    assert SKIN_METHODS == ("geometric", "rignet", "heterskinnet", "skinningnet")
-    assert SKIN_METHODS == (GEOMETRIC,) + NETWORK_NAMES
-    assert DEFAULT_SKIN_METHOD in SKIN_METHODS
+def test_the_methods_are_the_geometric_one_the_networks_and_their_ensemble():
+    assert SKIN_METHODS == ("geometric", "rignet", "heterskinnet", "skinningnet", "ensemble")
+    assert SKIN_METHODS == (GEOMETRIC,) + LEARNED_METHODS
+    assert DEFAULT_SKIN_METHOD == "heterskinnet" and ENSEMBLE_MEMBERS == ("heterskinnet", "skinningnet")
     assert set(SKIN_METHOD_LABELS) == set(SKIN_METHODS)
 
 
@@ -106,7 +117,7 @@ def test_geometric_runs_geometric_weights_with_every_option():
     np.testing.assert_array_equal(chosen.matrix, direct.matrix)
 
 
-@pytest.mark.parametrize("network", NETWORK_NAMES)
+@pytest.mark.parametrize("network", LEARNED_METHODS)
 def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(network):
     character = generate_character(CHARACTER_SEED, CHARACTER_KIND)
     mesh, skeleton = character.mesh, character.skeleton
@@ -122,6 +133,20 @@ def test_a_network_runs_learned_weights_and_ignores_the_geometric_options(networ
     expected, count = rigid_weights(mesh, direct.matrix)
     assert count > 0 and not np.array_equal(expected, direct.matrix)
     np.testing.assert_array_equal(rigid.matrix, expected)
+
+
+def test_the_ensemble_averages_its_networks_before_pruning_and_sharpening():
+    # The mean of the two networks' raw weights on the proxy, finished once: not the mean of two finished results.
+    mesh, skeleton = tube(), two_bone_skeleton(TUBE_HEIGHT)
+    ensemble = learned_weights(mesh, skeleton, ENSEMBLE, resolution=RESOLUTION).matrix
+    proxy = simplified_proxy(mesh, NETWORK_PROXY_VERTICES)
+    raw = [proxy_weights(proxy.mesh, skeleton, SKIN_NETWORKS[name], resolution=RESOLUTION) for name in ENSEMBLE_MEMBERS]
+    expected = proxy.carry(0.5 * (raw[0] + raw[1]),
+                           lambda rows, carried: finished_weights(carried, geometric.DEFAULT_MAX_INFLUENCES))
+    np.testing.assert_allclose(ensemble, expected, atol=1e-12)
+    # ... and it is neither network's own result.
+    for name in ENSEMBLE_MEMBERS:
+        assert np.abs(ensemble - learned_weights(mesh, skeleton, name, resolution=RESOLUTION).matrix).max() > 0.01
 
 
 def test_rignet_weights_a_skeleton_smaller_than_it_needs_through_cut_bones():
@@ -166,7 +191,7 @@ def test_ignored_options_are_the_changed_geometric_ones_with_a_network():
 # --------------------------------------------------------------------------- eval
 
 
-@pytest.mark.parametrize("network", NETWORK_NAMES)
+@pytest.mark.parametrize("network", LEARNED_METHODS)
 def test_eval_scores_each_network_as_the_skin_job_gives_it(network):
     evaluation_methods.check_method("skin", network)  # accepted
     assert network in evaluation_methods.method_names("skin")
@@ -259,7 +284,7 @@ def test_the_panels_and_operators_method_items_and_default_are_the_cores(clean_s
         assert method.default == DEFAULT_SKIN_METHOD.upper()
 
 
-@pytest.mark.parametrize("network", NETWORK_NAMES)
+@pytest.mark.parametrize("network", LEARNED_METHODS)
 def test_operator_skins_the_tube_with_each_network(clean_scene, capfd, network):
     import bpy
 
@@ -290,7 +315,7 @@ def test_operator_skins_a_generated_character_with_each_network(clean_scene, net
     assert_valid_weights(group_weights(body, bones), MAX_INFLUENCES)
 
 
-@pytest.mark.parametrize("network", NETWORK_NAMES)
+@pytest.mark.parametrize("network", LEARNED_METHODS)
 def test_no_deform_bones_with_a_network_is_refused_and_the_scene_unchanged(clean_scene, network):
     import bpy
 

@@ -30,6 +30,7 @@ from typing import Callable
 
 from ..core.dataset.split import DataItem
 from ..core.errors import InputError
+from ..core.skinning.learned.ensemble import ENSEMBLE
 from ..core.skinning.learned.networks import NETWORK_NAMES
 from ..core.skinning.methods import SKIN_METHOD_DESCRIPTIONS
 
@@ -241,7 +242,7 @@ register_skin_method("boneheat", _bone_heat, "Blender's Automatic Weights (bone 
 register_skin_method("nearest_bone", _nearest_bone, "each vertex wholly to its closest deform bone")
 register_skin_method("geometric", _skin_method("geometric"),
                      "core.skinning.geometric with the Skin job's defaults (rigid loose parts)")
-for _name in NETWORK_NAMES:
+for _name in NETWORK_NAMES + (ENSEMBLE,):
     register_skin_method(_name, _skin_method(_name),
                          f"{SKIN_METHOD_DESCRIPTIONS[_name]} (core.skinning.learned; rigid loose parts)")
 register_rig_method(

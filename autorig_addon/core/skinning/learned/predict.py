@@ -40,6 +40,7 @@ from ...types import Mesh, Skeleton, Weights
 from ...weights import limit_influences, prune_small, sharpened
 from ..geometric import DEFAULT_MAX_INFLUENCES, deform_bones_of, geometric_weights
 from ..heat_prior import heat_prior_weights
+from .ensemble import member_networks
 from .features import SkinGraph, skin_graph
 from .networks import skin_network
 from .networks.scoring import PRIOR_KINDS, SkinNetworkSpec, candidate_weights
@@ -159,13 +160,13 @@ def split_bones(skeleton: Skeleton, pieces: int) -> tuple[Skeleton, np.ndarray]:
 def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influences: int = DEFAULT_MAX_INFLUENCES,
                     resolution: int = DEFAULT_RESOLUTION, progress: ProgressCallback | None = None) -> Weights:
     """Skin weights of ``mesh`` for the deform bones of ``skeleton`` from a
-    trained network.
+    trained network, or from the ensemble of two (:mod:`.ensemble`).
 
     Parameters
     ----------
     mesh : Mesh, any space (the armature's and the mesh's must agree)
     skeleton : Skeleton; only bones with ``deform`` set get weights
-    network : one of :data:`.networks.NETWORK_NAMES`
+    network : one of :data:`.networks.NETWORK_NAMES`, or :data:`.ensemble.ENSEMBLE`
     max_influences : int >= 0, bones kept per vertex (0: no limit)
     resolution : int, voxel cells along the longest side
     progress : optional ProgressCallback
@@ -175,36 +176,51 @@ def learned_weights(mesh: Mesh, skeleton: Skeleton, network: str, *, max_influen
     Weights with one column per deform bone (in skeleton order); every row
     is non-negative, sums to 1 and has at most ``max_influences`` non-zeros.
 
-    A network that weights no fewer than ``min_deform_bones`` bones (RigNet:
-    3) sees a smaller skeleton with each bone cut into equal pieces
-    (:func:`split_bones`), and each bone gets the sum of its pieces' weights.
+    The ensemble averages its networks' raw weights on the proxy, before
+    the influence limit, pruning and sharpening (:func:`finished_weights`),
+    which are done once on the mean.
 
     Raises
     ------
     InputError for an unknown network, no deform bones or no vertices.
     """
-    spec = skin_network(network)
+    specs = [skin_network(name) for name in member_networks(network)]
     deform = deform_bones_of(mesh, skeleton)
-    owner = None
-    if len(deform) < spec.min_deform_bones:
-        skeleton_seen, owner = split_bones(skeleton, -(-spec.min_deform_bones // len(deform)))
-    else:
-        skeleton_seen = skeleton
-    shipped_weights(spec)  # a missing file fails before the long work
+    for spec in specs:
+        shipped_weights(spec)  # a missing file fails before the long work
     report(progress, 0.0, "Welding and simplifying the mesh")
     proxy = simplified_proxy(mesh, NETWORK_PROXY_VERTICES)
-    normalised = normalise(proxy.mesh, skeleton_seen)
-    graph = network_graph(normalised.mesh, normalised.skeleton, spec.distance, prior=spec.prior,
-                          resolution=resolution,
-                          progress=sub_progress(progress, 0.05, 0.9))
-    report(progress, 0.9, f"Running {network}")
-    weights = dense_weights(graph, network_candidate_weights(spec, graph))
-    if owner is not None:
-        summed = np.zeros((len(weights), len(deform)))
-        np.add.at(summed.T, owner, weights.T)
-        weights = summed
+    shares = np.linspace(0.05, 0.95, len(specs) + 1)
+    weights = np.mean([proxy_weights(proxy.mesh, skeleton, spec, resolution=resolution,
+                                     progress=sub_progress(progress, start, end))
+                       for spec, start, end in zip(specs, shares[:-1], shares[1:])], axis=0)
     report(progress, 0.95, "Carrying the weights to every vertex")
     weights = proxy.carry(weights, lambda rows, carried: finished_weights(carried, max_influences))
     report(progress, 1.0, "Weights done")
     return Weights(weights, tuple(skeleton.names[j] for j in deform))
 
+
+def proxy_weights(proxy: Mesh, skeleton: Skeleton, spec: SkinNetworkSpec, *, resolution: int = DEFAULT_RESOLUTION,
+                  progress: ProgressCallback | None = None) -> np.ndarray:
+    """(p, d) raw weights of one network on the ``proxy`` mesh (the one it
+    sees) for the d deform bones of ``skeleton``, rows summing to 1, before
+    any pruning.
+
+    A network that weights no fewer than ``min_deform_bones`` bones (RigNet:
+    3) sees a smaller skeleton with each bone cut into equal pieces
+    (:func:`split_bones`), and each bone gets the sum of its pieces' weights.
+    """
+    deform_count = int(np.count_nonzero(skeleton.deform))
+    owner = None
+    if deform_count < spec.min_deform_bones:
+        skeleton, owner = split_bones(skeleton, -(-spec.min_deform_bones // deform_count))
+    normalised = normalise(proxy, skeleton)
+    graph = network_graph(normalised.mesh, normalised.skeleton, spec.distance, prior=spec.prior,
+                          resolution=resolution, progress=sub_progress(progress, 0.0, 0.95))
+    report(progress, 0.95, f"Running {spec.name}")
+    weights = dense_weights(graph, network_candidate_weights(spec, graph))
+    if owner is None:
+        return weights
+    summed = np.zeros((len(weights), deform_count))
+    np.add.at(summed.T, owner, weights.T)
+    return summed
