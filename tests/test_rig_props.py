@@ -154,13 +154,13 @@ def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, cap
 
 def test_a_helmet_and_a_bracer_on_one_arm_are_skinned_not_held(clean_scene, capfd):
     """A helmet has a twin of itself across the mirror plane; a bracer on the
-    right forearm has none but lies on the body: both are skinned as the
+    right forearm (from just past the elbow) has none but lies on the body: both are skinned as the
     body is, through vertex groups, not held by one bone. The bracer, one
     piece weighted mostly to the forearm, is then bound wholly to it (a
     rigid loose part); without rigid parts it spreads over several bones."""
     body = add_biped()
     helmet = add_shell("Helmet", lambda vertices: vertices[:, 2] > 0.86)
-    bracer = add_shell("Bracer", lambda vertices: (vertices[:, 0] < -0.2) & (vertices[:, 0] > -0.25))
+    bracer = add_shell("Bracer", lambda vertices: (vertices[:, 0] < -0.165) & (vertices[:, 0] > -0.235))
     select_only([body, helmet, bracer], active=body)
 
     assert bpy.ops.autorig.auto_rig() == {"FINISHED"}

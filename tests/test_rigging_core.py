@@ -582,9 +582,9 @@ def test_a_character_facing_x_is_noted_and_turned_for_the_prediction(direction):
     _, mesh, votes, skeleton = turned_prediction(direction)
     assert votes.notes[0] == ("The character faces +-X; it was turned a quarter for the prediction (its mirror "
                               "plane is x = 0 of its own space).")
-    # The quarter turn that finds the mirror plane turns a character facing -X to face +Y; its feet tell, and
+    # The quarter turn that finds the mirror plane turns a character facing -X to face +Y; its toes tell, and
     # it is turned on to face -Y.
-    half_turn = ("The character faces away from -Y (turned, it reads as a biped); it was turned half a turn for the "
+    half_turn = ("The character faces away from -Y (its toes point toward +Y); it was turned half a turn for the "
                  "prediction, so its .L bones lie on its own left.")
     assert votes.notes[1:] == ((half_turn,) if direction == FACING_MINUS_X else ())
     assert votes.symmetric

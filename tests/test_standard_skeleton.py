@@ -11,21 +11,34 @@ from autorig_addon.core.rigging.metarig import metarig_placement
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
+    FOOT_BAND,
     FREE_FORM,
     MAX_NECK_LENGTH,
     QUADRUPED,
+    SHIN_BAND,
     SYMMETRIC_PAIR_DISTANCE,
+    TOE_REACH_SURE,
+    WRIST_PAST_NARROWEST,
+    WRIST_SEARCH_FROM,
+    WRIST_SEARCH_TO,
+    WRIST_SECTION_PERCENTILE,
     Landmarks,
     biped_skeleton,
+    faces_backward,
+    from_behind,
     head_near_neck,
     hips_at_most_at_hip_joints,
     landmark_warnings,
     quadruped_skeleton,
+    shoulders_on_arm_axes,
     symmetrised,
+    toe_reach,
+    wrists_past_narrowest_forearm,
 )
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.skeleton.naming import mirror_name
-from autorig_addon.core.types import Skeleton
+from autorig_addon.core.types import Mesh, Skeleton
+from geometry_fixtures import box_mesh
 
 BIPED_BONES = {
     "spine", "spine.001", "spine.002", "spine.003", "neck", "head",
@@ -218,3 +231,147 @@ def test_warnings_name_key_joints_outside_the_body_and_a_leg_out_of_order():
     )
     quadruped = landmark_warnings(landmarks, QUADRUPED, inside)
     assert quadruped[0] == "check the skeleton: the left front ankle could not be placed inside the body"
+
+
+def arm_and_chest_vertices():
+    """The left half of a T-posed body: a chest box (x 0 to 0.1) and an upper arm, a tube of radius 0.025 (a sixth
+    of its length to the elbow, as a human's) along +x from x = 0.1 to 0.3 around the line y = 0, z = 0.7; the right
+    half its mirror image."""
+    angles = np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)
+    arm = np.array([[x, 0.025 * np.cos(a), 0.7 + 0.025 * np.sin(a)]
+                    for x in np.linspace(0.1, 0.3, 201) for a in angles])
+    chest = np.array([[x, y, z] for x in np.linspace(0.0, 0.1, 6) for y in (-0.08, 0.08)
+                      for z in np.linspace(0.45, 0.8, 15)])
+    left = np.concatenate([arm, chest])
+    return np.concatenate([left, left * [-1.0, 1.0, 1.0]])
+
+
+def test_a_bipeds_shoulder_joints_come_onto_the_arms_axes():
+    vertices = arm_and_chest_vertices()
+    # Shoulders toward the top of the shoulder, 0.025 above the arm's axis and 0.01 in front; elbows on the axis.
+    points = {"shoulder.L": np.array([0.1, -0.01, 0.725]), "elbow.L": np.array([0.25, 0.0, 0.7]),
+              "shoulder.R": np.array([-0.1, -0.01, 0.725]), "elbow.R": np.array([-0.25, 0.0, 0.7])}
+    moved = shoulders_on_arm_axes(points, vertices)
+    # The slice 30 % of the way to the elbow (x 0.137 to 0.175 of the tube, the chest out of it) is centred on the
+    # axis, so the shoulders come straight down onto it, staying where they were along the arm.
+    np.testing.assert_allclose(moved["shoulder.L"], [0.1, 0.0, 0.7], atol=5e-4)
+    np.testing.assert_allclose(moved["shoulder.R"], [-0.1, 0.0, 0.7], atol=5e-4)
+    np.testing.assert_array_equal(moved["elbow.L"], points["elbow.L"])
+    assert points["shoulder.L"][2] == 0.725  # the caller's landmarks are left as they were
+    # An arm with nothing across it (the elbow far from any vertex) keeps its shoulder.
+    lost = dict(points, **{"elbow.L": np.array([0.1, 0.0, 2.0])})
+    np.testing.assert_array_equal(shoulders_on_arm_axes(lost, vertices)["shoulder.L"], points["shoulder.L"])
+
+
+def forearm_and_hand_vertices():
+    """A T-posed left forearm along +x at y = 0, z = 0.7: a tube from the elbow (x 0.25, radius 0.03) narrowing
+    to radius 0.02 at the wrist (x 0.45), then a hand as wide as the forearm's start, radius 0.04 to x 0.55; the
+    right arm its mirror image."""
+    angles = np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)
+
+    def rings(xs, radii):
+        return np.array([[x, r * np.cos(a), 0.7 + r * np.sin(a)] for x, r in zip(xs, radii) for a in angles])
+
+    forearm_x = np.linspace(0.25, 0.45, 201)
+    left = np.concatenate([rings(forearm_x, 0.03 - 0.05 * (forearm_x - 0.25)),
+                           rings(np.linspace(0.451, 0.55, 100), np.full(100, 0.04))])
+    return np.concatenate([left, left * [-1.0, 1.0, 1.0]])
+
+
+def test_a_bipeds_wrist_joints_go_just_past_the_forearms_narrowest_section():
+    assert (WRIST_SEARCH_FROM, WRIST_SEARCH_TO, WRIST_PAST_NARROWEST) == (0.8, 1.4, 0.05)
+    vertices = forearm_and_hand_vertices()
+    # The network's wrists 0.03 short of the wrist, on the forearm's axis: forearm 0.17 long.
+    points = {"elbow.L": np.array([0.25, 0.0, 0.7]), "wrist.L": np.array([0.42, 0.0, 0.7]),
+              "elbow.R": np.array([-0.25, 0.0, 0.7]), "wrist.R": np.array([-0.42, 0.0, 0.7])}
+    moved = wrists_past_narrowest_forearm(points, vertices)
+    # The narrowest section (half as thick as 0.05 of the forearm, 0.0085) is the last one wholly before the hand,
+    # centred at 0.45 - 0.0085; the wrist goes 0.05 of the forearm (0.0085) past it: x 0.45, where the hand starts,
+    # on the axis (to within a step of the search, 0.01 of the forearm).
+    np.testing.assert_allclose(moved["wrist.L"], [0.45, 0.0, 0.7], atol=2e-3)
+    np.testing.assert_allclose(moved["wrist.R"], [-0.45, 0.0, 0.7], atol=2e-3)
+    np.testing.assert_array_equal(moved["elbow.L"], points["elbow.L"])
+    assert points["wrist.L"][0] == 0.42  # the caller's landmarks are left as they were
+    # A forearm hanging more than 45 degrees down keeps its wrist (its sections would run into the body).
+    hanging = dict(points, **{"wrist.L": np.array([0.25 + 0.17 * 0.6, 0.0, 0.7 - 0.17 * 0.8])})
+    np.testing.assert_array_equal(wrists_past_narrowest_forearm(hanging, vertices)["wrist.L"], hanging["wrist.L"])
+    # So does one with no vertices across it.
+    empty = wrists_past_narrowest_forearm(points, vertices[vertices[:, 0] < 0])
+    np.testing.assert_array_equal(empty["wrist.L"], points["wrist.L"])
+
+
+def test_a_flat_palm_is_not_taken_for_the_wrist():
+    # The hand a flat plate 0.07 wide and 0.01 thick: most of its outline lies nearer the line than the wrist's
+    # radius (0.02), but its width is its outline's far points, so the wrist is still where the forearm ends.
+    angles = np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)
+    forearm_x = np.linspace(0.25, 0.45, 201)
+    forearm = np.array([[x, r * np.cos(a), 0.7 + r * np.sin(a)]
+                        for x, r in zip(forearm_x, 0.03 - 0.05 * (forearm_x - 0.25)) for a in angles])
+    palm = np.array([[x, y, 0.7 + z] for x in np.linspace(0.451, 0.55, 100) for y in np.linspace(-0.035, 0.035, 15)
+                     for z in (-0.005, 0.005)])
+    left = np.concatenate([forearm, palm])
+    points = {"elbow.L": np.array([0.25, 0.0, 0.7]), "wrist.L": np.array([0.42, 0.0, 0.7]),
+              "elbow.R": np.array([-0.25, 0.0, 0.7]), "wrist.R": np.array([-0.42, 0.0, 0.7])}
+    moved = wrists_past_narrowest_forearm(points, np.concatenate([left, left * [-1.0, 1.0, 1.0]]))
+    # Within 5 mm (the sections next to the palm take in a few of its points); measured by the median distance
+    # instead of the outline, the wrist would go 1.6 cm into the palm.
+    assert WRIST_SECTION_PERCENTILE == 90
+    np.testing.assert_allclose(moved["wrist.L"], [0.45, 0.0, 0.7], atol=5e-3)
+
+
+def boxes(*corners, spacing=0.02) -> Mesh:
+    """One mesh of axis-aligned boxes, each given as (low, high)."""
+    meshes = [box_mesh(low, high, spacing) for low, high in corners]
+    offsets = np.cumsum([0] + [mesh.vertex_count for mesh in meshes[:-1]])
+    return Mesh(np.concatenate([mesh.vertices for mesh in meshes]),
+                np.concatenate([mesh.triangles + offset for mesh, offset in zip(meshes, offsets)]))
+
+
+def test_the_toes_reach_is_how_much_farther_the_feet_reach_ahead_of_the_shins_than_behind():
+    assert (FOOT_BAND, SHIN_BAND, TOE_REACH_SURE) == (0.05, (0.12, 0.25), 0.02)
+    legs = []
+    for sign in (1.0, -1.0):
+        x = sorted((sign * 0.05, sign * 0.15))
+        legs += [([x[0], -0.03, 0.13], [x[1], 0.03, 0.24]),  # a shin centred on y = 0, within the shin band
+                 ([x[0], -0.12, 0.0], [x[1], 0.04, 0.04])]  # a foot from 0.12 ahead of it to 0.04 behind
+    body = boxes(*legs, ([-0.15, -0.05, 0.5], [0.15, 0.05, 1.0]))  # and a trunk, for a height of 1
+    # Each foot reaches 0.12 ahead of its shin's middle and 0.04 behind: 0.08 of the height toward -y.
+    assert toe_reach(body) == pytest.approx(0.08, abs=1e-12)
+    turned = Mesh(body.vertices * [-1.0, -1.0, 1.0], body.triangles)
+    assert toe_reach(turned) == pytest.approx(-0.08, abs=1e-12)
+    # A generated biped facing -y, as the generator makes it, and turned half a turn.
+    character = generate_character(0, BIPED)
+    surface = normalise(character.mesh, character.skeleton).mesh
+    assert toe_reach(surface) > TOE_REACH_SURE
+    assert toe_reach(Mesh(surface.vertices * [-1.0, -1.0, 1.0], surface.triangles)) < -TOE_REACH_SURE
+
+
+@pytest.mark.parametrize(("toes", "turned_kind", "backward"), [
+    (0.05, BIPED, False),  # toes ahead: kept, though turned it reads far more surely as a biped
+    (-0.05, BIPED, True),  # toes behind: turned
+    (0.01, BIPED, True),  # the toes do not tell: the surer reading turned decides
+    (0.05, "other", False),
+    (None, BIPED, True),  # no toes read (no legs found)
+])
+def test_a_bipeds_toes_decide_which_way_it_faces_when_they_tell(toes, turned_kind, backward):
+    as_it_is = Landmarks({name: np.zeros(3) for name in LANDMARKS}, {"biped": 0.3, "quadruped": 0.0, "other": 0.7})
+    probabilities = {"biped": 0.0, "quadruped": 0.0, "other": 0.0}
+    probabilities[turned_kind] = 1.0
+    if turned_kind != BIPED:
+        probabilities["biped"], probabilities[turned_kind] = 0.9, 0.1  # surer, but the toes decide for a biped
+    turned = Landmarks({name: np.zeros(3) for name in LANDMARKS}, probabilities)
+    assert faces_backward(as_it_is, np.zeros((1, 3)), turned, toes) is backward
+
+
+def test_a_reading_from_behind_is_turned_back_with_its_sides_swapped():
+    points = {name: np.zeros(3) for name in LANDMARKS}
+    # Read from behind, the network put a "left" wrist at +x of the turned frame: the character's right hand.
+    points["wrist.L"], points["wrist.R"] = np.array([0.3, 0.02, 0.6]), np.array([-0.3, 0.02, 0.6])
+    points["head"] = np.array([0.0, 0.01, 0.9])
+    turned = Landmarks(points, {"biped": 0.9, "quadruped": 0.0, "other": 0.1})
+    back = from_behind(turned)
+    # Turned back half a turn: its right hand at -x, in front (y -0.02) as the hand was seen from behind.
+    np.testing.assert_allclose(back.points["wrist.R"], [-0.3, -0.02, 0.6])
+    np.testing.assert_allclose(back.points["wrist.L"], [0.3, -0.02, 0.6])
+    np.testing.assert_allclose(back.points["head"], [0.0, -0.01, 0.9])
+    assert set(back.points) == set(LANDMARKS) and back.kind_probabilities == turned.kind_probabilities

@@ -8,8 +8,9 @@ facing +X, one turned by an odd angle on its turntable. :func:`upright_rotation`
 finds the rotation; :mod:`.predict` rigs the character in that frame and
 brings the skeleton back, so the bones stand where the mesh is and ``.L``
 is on the character's own left. Which of the two ways along the found axis
-the character faces (-Y or +Y) is the landmark network's and the feet's
-call (``standard_skeleton.faces_backward``), after this.
+the character faces (-Y or +Y) is the toes' call for a biped, else the
+landmark network's and the feet's (``standard_skeleton.faces_backward``),
+after this.
 
 Up is chosen among the six axis directions of the mesh's own space (a
 character is modelled upright along one of them), and the facing among

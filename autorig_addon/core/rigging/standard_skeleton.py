@@ -40,12 +40,13 @@ import numpy as np
 from ..nn.numpy_kernels import NUMPY
 from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
-from ..skeleton.naming import chain_names
+from ..skeleton.naming import chain_names, mirror_name
 from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import VERTEX_VECTORS, JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
+from .up_features import area_centroids
 
 BIPED, QUADRUPED, OTHER = BODY_KINDS
 #: Template choices: the network's guess, one kind forced, or the free-form skeleton.
@@ -166,6 +167,121 @@ def head_near_neck(points: dict) -> dict:
     return points
 
 
+#: The upper arm's axis is read from the slice of the mesh across it this
+#: share of the way from the shoulder joint to the elbow joint, this thick
+#: (each side, share of the upper arm's length) and out to this radius from
+#: the line between them (:func:`shoulders_on_arm_axes`). Chosen on the
+#: training characters' own rigs (every third humanoid, 2026-11-26): the
+#: axis so read through the artist's elbow passes a median 0.006 from the
+#: artist's shoulder joint, 4 % of them farther than 0.025, the closest of
+#: the settings tried (shares 0.3 to 0.5, thickness 0.1 and 0.2, radius 0.35
+#: and 0.5; at 0.5 of the way the slice reaches the elbow's bulge, at radius
+#: 0.5 the chest).
+ARM_SLICE_AT = 0.3
+ARM_SLICE_HALF_THICKNESS = 0.2
+ARM_SLICE_RADIUS = 0.35
+
+
+def shoulders_on_arm_axes(points: dict, vertices: np.ndarray) -> dict:
+    """A biped's landmarks with each shoulder joint (the upper arm's head)
+    moved onto its arm's axis: the line through the elbow joint and the
+    centre of the upper arm's cross-section (:data:`ARM_SLICE_AT`), the
+    shoulder taken to the closest point of that line. Artists start the
+    upper arm on the arm's axis; on bodies unlike the training ones the
+    network put it 0.03 above it (median over the validation humanoids),
+    on the top of the shoulder. An arm whose slice holds fewer than three
+    of ``vertices`` (the normalised proxy's) keeps its shoulder."""
+    points = dict(points)
+    for side, sign in ((LEFT, 1.0), (RIGHT, -1.0)):
+        shoulder, elbow = points["shoulder" + side], points["elbow" + side]
+        upper_arm = elbow - shoulder
+        length = float(np.linalg.norm(upper_arm))
+        if length <= 1e-9:
+            continue
+        direction = upper_arm / length
+        offsets = vertices - (shoulder + ARM_SLICE_AT * upper_arm)
+        along = offsets @ direction
+        across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
+        # The arm's own side only: an arm hanging by the body has the chest within reach.
+        slice_ = vertices[(np.abs(along) <= ARM_SLICE_HALF_THICKNESS * length)
+                          & (across <= ARM_SLICE_RADIUS * length) & (sign * vertices[:, 0] > 0)]
+        if len(slice_) < 3:
+            continue
+        axis = slice_.mean(axis=0) - elbow
+        if np.linalg.norm(axis) <= 1e-9:
+            continue
+        axis /= np.linalg.norm(axis)
+        points["shoulder" + side] = elbow + float((shoulder - elbow) @ axis) * axis
+    return points
+
+
+#: The wrist joint (the hand's head) is read from the mesh where the forearm
+#: is narrowest (:func:`wrists_past_narrowest_forearm`): sections across the
+#: line from the elbow joint through the network's wrist joint are measured
+#: from this to this share of the way between them (0.8 to 1.4: up to 40 %
+#: past the network's wrist, which it put 0.046 short of the artists' on the
+#: validation humanoids), each this thick (each side, share of the forearm)
+#: and out to this radius from the line, in :data:`WRIST_SECTION_STEPS`
+#: steps; a section's width is this percentile of its vertices' distances
+#: from the line (its outline: a flat palm is wide, though most of it lies
+#: near the line), and one needs :data:`MIN_SECTION_VERTICES` to count.
+WRIST_SEARCH_FROM, WRIST_SEARCH_TO = 0.8, 1.4
+WRIST_SECTION_HALF_THICKNESS = 0.05
+WRIST_SECTION_RADIUS = 0.6
+WRIST_SECTION_STEPS = 61
+WRIST_SECTION_PERCENTILE = 90
+MIN_SECTION_VERTICES = 5
+#: Artists put the wrist joint just past the forearm's narrowest section,
+#: toward the hand: this share of the forearm. Chosen on every third
+#: training humanoid's own rig (2026-11-26): read from the artist's own
+#: elbow and wrist, the wrist so placed lies a median 0.006 from the
+#: artist's (2 of 28 farther than 0.05, at most 0.062), the closest of the
+#: offsets tried from 0 to 0.15 (0: 0.010; 0.1: 0.011; 0.15: 0.017). With
+#: the median distance instead of the outline, 0.023; searched from 0.6 to
+#: 1.6, the hand's own narrow places come in reach.
+WRIST_PAST_NARROWEST = 0.05
+#: A forearm pointing more than this below the horizontal hangs by the body,
+#: whose side (or a dress, a sleeve) its sections run into: its wrist is
+#: kept. On the predicted skeletons of every third training humanoid, the
+#: 0 A.D. humans' forearms hang about 70 degrees down, and read so their
+#: wrists would fall from 95.7 % right to 87.9 %; from 30 to 50 degrees the
+#: other 28 wrists are read and none is lost.
+HANGING_FOREARM_DEGREES = 45.0
+
+
+def wrists_past_narrowest_forearm(points: dict, vertices: np.ndarray) -> dict:
+    """A biped's landmarks with each wrist joint moved along its forearm to
+    :data:`WRIST_PAST_NARROWEST` past the forearm's narrowest section
+    (sections of ``vertices``, the normalised mesh, on the arm's side; see
+    :data:`WRIST_SEARCH_FROM`), unless the forearm hangs
+    (:data:`HANGING_FOREARM_DEGREES`) or no section holds enough vertices."""
+    points = dict(points)
+    steps = np.linspace(WRIST_SEARCH_FROM, WRIST_SEARCH_TO, WRIST_SECTION_STEPS)
+    for side, sign in ((LEFT, 1.0), (RIGHT, -1.0)):
+        elbow, wrist = points["elbow" + side], points["wrist" + side]
+        forearm = wrist - elbow
+        length = float(np.linalg.norm(forearm))
+        if length <= 1e-9 or forearm[2] < -length * np.sin(np.radians(HANGING_FOREARM_DEGREES)):
+            continue
+        direction = forearm / length
+        offsets = vertices - elbow
+        along = offsets @ direction
+        across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
+        near = ((across <= WRIST_SECTION_RADIUS * length) & (sign * vertices[:, 0] > 0)
+                & (along >= (WRIST_SEARCH_FROM - WRIST_SECTION_HALF_THICKNESS) * length)
+                & (along <= (WRIST_SEARCH_TO + WRIST_SECTION_HALF_THICKNESS) * length))
+        along, across = along[near] / length, across[near]
+        widths = np.full(len(steps), np.inf)
+        for index, step in enumerate(steps):
+            section = across[np.abs(along - step) <= WRIST_SECTION_HALF_THICKNESS]
+            if len(section) >= MIN_SECTION_VERTICES:
+                widths[index] = np.percentile(section, WRIST_SECTION_PERCENTILE)
+        if np.isfinite(widths).any():
+            narrowest = steps[int(np.argmin(widths))]
+            points["wrist" + side] = elbow + (narrowest + WRIST_PAST_NARROWEST) * forearm
+    return points
+
+
 #: A biped faces +y when its feet reach this many times as far behind the
 #: ankles as ahead of them (toes point forward: a foot reaches about three
 #: times as far ahead of the ankle as behind it).
@@ -189,11 +305,70 @@ def half_turned(graph: JointGraph) -> JointGraph:
                    vertex_features=graph.vertex_features * flip)
 
 
-def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks | None = None) -> bool:
-    """Whether the character faces +y instead of -y (normalised frame): the
-    landmark network reads it much more surely as a biped or quadruped when
-    turned half a turn (``turned``, its landmarks on :func:`half_turned`), or
-    a biped's feet reach behind its ankles. Only a clear case counts."""
+def from_behind(turned: Landmarks) -> Landmarks:
+    """The landmarks read on the character turned half a turn
+    (:func:`half_turned`), brought back to it as it stands: every point
+    turned back and left and right swapped. Read from behind, a character
+    facing -y looks to the network like one facing it, so it took the
+    character's right for its left; the positions themselves hold."""
+    flip = np.array([-1.0, -1.0, 1.0])
+    return Landmarks({mirror_name(name): np.asarray(point) * flip for name, point in turned.points.items()},
+                     dict(turned.kind_probabilities))
+
+
+#: The toes' cue of which way a biped faces (:func:`toe_reach`): its feet
+#: are the lowest band of this share of its height, its shins the band
+#: between these shares.
+FOOT_BAND = 0.05
+SHIN_BAND = (0.12, 0.25)
+#: A biped whose feet reach this much farther (share of its height) ahead of
+#: its shins than behind faces that way, whatever the landmark network reads;
+#: nearer even, the toes do not tell. Measured on the training humanoids'
+#: proxies as they are, facing -y (2026-11-26): the feet reach farther toward
+#: -y on 175 of 178 (median 0.09, 5th percentile 0.027); at 0.02, 171 say -y,
+#: 2 say +y, 5 do not tell. No network reads this cue, so the training
+#: characters measure it as fairly as new ones.
+TOE_REACH_SURE = 0.02
+
+
+def toe_reach(surface: Mesh) -> float | None:
+    """How much farther a biped's feet reach toward -y than toward +y from
+    the middle of its shins, averaged over its two legs, as a share of its
+    height (positive: it faces -y); None when a leg has no foot or shin.
+    ``surface`` is upright in the normalised frame, its mirror plane across
+    x; the legs are the two sides of it. Toes point forward: a foot reaches
+    farther ahead of the leg above it than its heel does behind."""
+    points, shares = area_centroids(surface.vertices, surface.triangles)
+    heights = points[:, 2] - points[:, 2].min()
+    height = float(heights.max())
+    across = points[:, 0] - 0.5 * (points[:, 0].min() + points[:, 0].max())
+    reaches = []
+    for sign in (1.0, -1.0):
+        side = sign * across > 0.01 * height
+        foot = side & (heights < FOOT_BAND * height)
+        shin = side & (heights > SHIN_BAND[0] * height) & (heights < SHIN_BAND[1] * height)
+        if foot.sum() < 3 or shin.sum() < 3:
+            return None
+        middle = float(np.average(points[shin, 1], weights=shares[shin]))
+        reaches.append((middle - points[foot, 1].min()) - (points[foot, 1].max() - middle))
+    return float(np.mean(reaches)) / max(height, 1e-12)
+
+
+def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks | None = None,
+                   toes: float | None = None) -> bool:
+    """Whether the character faces +y instead of -y (normalised frame).
+
+    A biped (read so either way) whose toes tell (``toes``, its
+    :func:`toe_reach`, beyond :data:`TOE_REACH_SURE` either way) faces
+    where they point. Otherwise only a clear case counts: the landmark
+    network reads it much more surely as a biped or quadruped when turned
+    half a turn (``turned``, its landmarks on :func:`half_turned`), or a
+    biped's feet reach behind its ankles (``vertices``: the proxy's).
+    The toes come first: the network's readings of bodies unlike its
+    training ones turned 7 validation humanoids facing -y (docs/rigging.md)."""
+    biped = landmarks.kind == BIPED or (turned is not None and turned.kind == BIPED)
+    if biped and toes is not None and abs(toes) > TOE_REACH_SURE:
+        return toes < 0.0
     if turned is not None and standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
         return True
     points = landmarks.points
@@ -421,6 +596,10 @@ def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, sym
     points = symmetrised(landmarks.points, symmetric_shape)
     if kind == BIPED:
         points = head_near_neck(hips_at_most_at_hip_joints(points))
+        # Each arm is read on its own side; a symmetric shape's shoulders and wrists stay mirror images.
+        arms_from = vertices if surface is None else surface.vertices
+        points = symmetrised(wrists_past_narrowest_forearm(shoulders_on_arm_axes(points, vertices), arms_from),
+                             symmetric_shape)
         fingers = both_hands_fingers(points, surface, symmetric_shape) if surface is not None else None
         return biped_skeleton(points, vertices, fingers)
     if kind == QUADRUPED:
