@@ -244,7 +244,7 @@ WRIST_PAST_NARROWEST = 0.05
 #: whose side (or a dress, a sleeve) its sections run into: its wrist is
 #: kept. On the predicted skeletons of every third training humanoid, the
 #: 0 A.D. humans' forearms hang about 70 degrees down, and read so their
-#: wrists would fall from 95.7 % right to 87.9 %; from 30 to 50 degrees the
+#: wrists would fall from 95.7 % right to 92.2 %; from 30 to 50 degrees the
 #: other 28 wrists are read and none is lost.
 HANGING_FOREARM_DEGREES = 45.0
 
