@@ -26,9 +26,10 @@ from autorig_addon.core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.geometry.proxy import simplified_proxy
 from autorig_addon.core.rigging import predict
+from autorig_addon.core.rigging.facing import half_turned
 from autorig_addon.core.rigging.joint_features import PROXY_VERTICES
 from autorig_addon.core.rigging.orientation import stand_upright
-from autorig_addon.core.rigging.standard_skeleton import half_turned, predict_landmarks, standard_confidence
+from autorig_addon.core.rigging.standard_skeleton import predict_landmarks, standard_confidence
 from autorig_addon.core.rigging.up_features import rotation_about_x
 from autorig_addon.core.types import Mesh
 

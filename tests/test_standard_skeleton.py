@@ -11,34 +11,27 @@ from autorig_addon.core.rigging.metarig import metarig_placement
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
-    FOOT_BAND,
     FREE_FORM,
     MAX_NECK_LENGTH,
     QUADRUPED,
-    SHIN_BAND,
     SYMMETRIC_PAIR_DISTANCE,
-    TOE_REACH_SURE,
     WRIST_PAST_NARROWEST,
     WRIST_SEARCH_FROM,
     WRIST_SEARCH_TO,
     WRIST_SECTION_PERCENTILE,
     Landmarks,
     biped_skeleton,
-    faces_backward,
-    from_behind,
     head_near_neck,
     hips_at_most_at_hip_joints,
     landmark_warnings,
     quadruped_skeleton,
     shoulders_on_arm_axes,
     symmetrised,
-    toe_reach,
     wrists_past_narrowest_forearm,
 )
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.skeleton.naming import mirror_name
-from autorig_addon.core.types import Mesh, Skeleton
-from geometry_fixtures import box_mesh
+from autorig_addon.core.types import Skeleton
 
 BIPED_BONES = {
     "spine", "spine.001", "spine.002", "spine.003", "neck", "head",
@@ -317,61 +310,3 @@ def test_a_flat_palm_is_not_taken_for_the_wrist():
     # instead of the outline, the wrist would go 1.6 cm into the palm.
     assert WRIST_SECTION_PERCENTILE == 90
     np.testing.assert_allclose(moved["wrist.L"], [0.45, 0.0, 0.7], atol=5e-3)
-
-
-def boxes(*corners, spacing=0.02) -> Mesh:
-    """One mesh of axis-aligned boxes, each given as (low, high)."""
-    meshes = [box_mesh(low, high, spacing) for low, high in corners]
-    offsets = np.cumsum([0] + [mesh.vertex_count for mesh in meshes[:-1]])
-    return Mesh(np.concatenate([mesh.vertices for mesh in meshes]),
-                np.concatenate([mesh.triangles + offset for mesh, offset in zip(meshes, offsets)]))
-
-
-def test_the_toes_reach_is_how_much_farther_the_feet_reach_ahead_of_the_shins_than_behind():
-    assert (FOOT_BAND, SHIN_BAND, TOE_REACH_SURE) == (0.05, (0.12, 0.25), 0.02)
-    legs = []
-    for sign in (1.0, -1.0):
-        x = sorted((sign * 0.05, sign * 0.15))
-        legs += [([x[0], -0.03, 0.13], [x[1], 0.03, 0.24]),  # a shin centred on y = 0, within the shin band
-                 ([x[0], -0.12, 0.0], [x[1], 0.04, 0.04])]  # a foot from 0.12 ahead of it to 0.04 behind
-    body = boxes(*legs, ([-0.15, -0.05, 0.5], [0.15, 0.05, 1.0]))  # and a trunk, for a height of 1
-    # Each foot reaches 0.12 ahead of its shin's middle and 0.04 behind: 0.08 of the height toward -y.
-    assert toe_reach(body) == pytest.approx(0.08, abs=1e-12)
-    turned = Mesh(body.vertices * [-1.0, -1.0, 1.0], body.triangles)
-    assert toe_reach(turned) == pytest.approx(-0.08, abs=1e-12)
-    # A generated biped facing -y, as the generator makes it, and turned half a turn.
-    character = generate_character(0, BIPED)
-    surface = normalise(character.mesh, character.skeleton).mesh
-    assert toe_reach(surface) > TOE_REACH_SURE
-    assert toe_reach(Mesh(surface.vertices * [-1.0, -1.0, 1.0], surface.triangles)) < -TOE_REACH_SURE
-
-
-@pytest.mark.parametrize(("toes", "turned_kind", "backward"), [
-    (0.05, BIPED, False),  # toes ahead: kept, though turned it reads far more surely as a biped
-    (-0.05, BIPED, True),  # toes behind: turned
-    (0.01, BIPED, True),  # the toes do not tell: the surer reading turned decides
-    (0.05, "other", False),
-    (None, BIPED, True),  # no toes read (no legs found)
-])
-def test_a_bipeds_toes_decide_which_way_it_faces_when_they_tell(toes, turned_kind, backward):
-    as_it_is = Landmarks({name: np.zeros(3) for name in LANDMARKS}, {"biped": 0.3, "quadruped": 0.0, "other": 0.7})
-    probabilities = {"biped": 0.0, "quadruped": 0.0, "other": 0.0}
-    probabilities[turned_kind] = 1.0
-    if turned_kind != BIPED:
-        probabilities["biped"], probabilities[turned_kind] = 0.9, 0.1  # surer, but the toes decide for a biped
-    turned = Landmarks({name: np.zeros(3) for name in LANDMARKS}, probabilities)
-    assert faces_backward(as_it_is, np.zeros((1, 3)), turned, toes) is backward
-
-
-def test_a_reading_from_behind_is_turned_back_with_its_sides_swapped():
-    points = {name: np.zeros(3) for name in LANDMARKS}
-    # Read from behind, the network put a "left" wrist at +x of the turned frame: the character's right hand.
-    points["wrist.L"], points["wrist.R"] = np.array([0.3, 0.02, 0.6]), np.array([-0.3, 0.02, 0.6])
-    points["head"] = np.array([0.0, 0.01, 0.9])
-    turned = Landmarks(points, {"biped": 0.9, "quadruped": 0.0, "other": 0.1})
-    back = from_behind(turned)
-    # Turned back half a turn: its right hand at -x, in front (y -0.02) as the hand was seen from behind.
-    np.testing.assert_allclose(back.points["wrist.R"], [-0.3, -0.02, 0.6])
-    np.testing.assert_allclose(back.points["wrist.L"], [0.3, -0.02, 0.6])
-    np.testing.assert_allclose(back.points["head"], [0.0, -0.01, 0.9])
-    assert set(back.points) == set(LANDMARKS) and back.kind_probabilities == turned.kind_probabilities

@@ -8,9 +8,7 @@ facing +X, one turned by an odd angle on its turntable. :func:`upright_rotation`
 finds the rotation; :mod:`.predict` rigs the character in that frame and
 brings the skeleton back, so the bones stand where the mesh is and ``.L``
 is on the character's own left. Which of the two ways along the found axis
-the character faces (-Y or +Y) is the toes' call for a biped, else the
-landmark network's and the feet's (``standard_skeleton.faces_backward``),
-after this.
+the character faces (-Y or +Y) is :mod:`.facing`'s call, after this.
 
 Up is chosen among the six axis directions of the mesh's own space (a
 character is modelled upright along one of them), and the facing among
@@ -43,8 +41,9 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from ..nn.numpy_kernels import NUMPY
 from ..nn.spec import shipped_weights
+from .facing import TURNED_CONFIDENCE_GAIN
 from .networks import upright as upright_network
-from .standard_skeleton import KIND_CONFIDENCE, TURNED_CONFIDENCE_GAIN, standard_confidence
+from .standard_skeleton import KIND_CONFIDENCE, standard_confidence
 from .symmetry import CLEARLY_BETTER, mirror_error_across
 from .up_features import MIDLINE_SHARE, UP_BANDS, UP_CANDIDATES, area_centroids, candidate_features
 
@@ -300,7 +299,7 @@ def stand_upright(points: np.ndarray, triangles: np.ndarray, landmarks_of: Calla
     4. A way is taken when the upright network does not plainly contradict
        it (:data:`UP_NOT_CONTRADICTED`) and prefers it to its opposite, and
        it reads as a standing biped or quadruped, more
-       surely than as it is by :data:`.standard_skeleton.TURNED_CONFIDENCE_GAIN`
+       surely than as it is by :data:`.facing.TURNED_CONFIDENCE_GAIN`
        unless it was tried as a sure thing, and standing on something like
        feet (:data:`STANDING_MIDLINE`: a fish stood on its tail reads as a
        biped, but stands on a fin). Of two such ways the upright network

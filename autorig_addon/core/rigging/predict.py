@@ -40,6 +40,7 @@ from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
+from .facing import facing, from_behind, half_turned
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
@@ -55,17 +56,11 @@ from .standard_skeleton import (
     KIND_CONFIDENCE,
     NEAR_SYMMETRIC_ERROR,
     TEMPLATES,
-    TOE_REACH_SURE,
-    TURNED_CONFIDENCE_GAIN,
     Landmarks,
-    faces_backward,
-    from_behind,
-    half_turned,
     landmark_warnings,
     predict_landmarks,
     standard_confidence,
     standard_skeleton,
-    toe_reach,
 )
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
@@ -228,27 +223,17 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     notes += stance.notes
     rotation = stance.rotation
     transform, graph, solid, landmarks = read(rotation)
-    toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
     turned = read_turned(rotation)
-    toes_tell = BIPED in (landmarks.kind, turned.kind) and toes is not None and abs(toes) > TOE_REACH_SURE
-    if faces_backward(landmarks, graph.vertices, turned, toes):
+    way = facing(landmarks, turned, Mesh(graph.vertices, proxy.triangles))
+    if way.turn:
         # Turned half a turn the character faces -y as the networks expect, its left at +x.
-        if toes_tell:
-            why = "its toes point toward +Y"
-        elif standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
-            why = f"turned, it reads more surely as a {turned.kind}"
-        else:
-            why = "its feet reach further behind its ankles than ahead"
         rotation = HALF_TURN @ rotation
         transform, graph, solid, landmarks = read(rotation)
-        notes.append(f"The character faces away from -Y ({why}); it was turned half a turn for the prediction, so "
-                     "its .L bones lie on its own left.")
-    elif toes_tell and standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
-        # It faces -y by its toes, but its body reads far more surely from behind (a shape unlike the training
-        # ones): that reading, turned back with its sides swapped.
+        notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
+                     "prediction, so its .L bones lie on its own left.")
+    elif way.read_from_behind:
         landmarks = from_behind(turned)
-        notes.append(f"The character faces -Y (its toes point that way) but reads more surely as a {landmarks.kind} "
-                     "from behind: its landmarks were read from behind and turned back.")
+        notes.append(way.reason)
     landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
     report(progress, 0.7, "Running the joint network")

@@ -33,20 +33,19 @@ facing -y, left at +x).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..nn.numpy_kernels import NUMPY
 from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
-from ..skeleton.naming import chain_names, mirror_name
+from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
-from .joint_features import VERTEX_VECTORS, JointGraph
+from .joint_features import JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
-from .up_features import area_centroids
 
 BIPED, QUADRUPED, OTHER = BODY_KINDS
 #: Template choices: the network's guess, one kind forced, or the free-form skeleton.
@@ -280,110 +279,6 @@ def wrists_past_narrowest_forearm(points: dict, vertices: np.ndarray) -> dict:
             narrowest = steps[int(np.argmin(widths))]
             points["wrist" + side] = elbow + (narrowest + WRIST_PAST_NARROWEST) * forearm
     return points
-
-
-#: A biped faces +y when its feet reach this many times as far behind the
-#: ankles as ahead of them (toes point forward: a foot reaches about three
-#: times as far ahead of the ankle as behind it).
-BACKWARD_FEET_RATIO = 1.5
-
-
-#: Turned half a turn, a character is taken to face the other way when the
-#: landmark network is at least this much surer there that it is a biped or
-#: a quadruped (it learnt bodies facing -y: a dog facing +y reads as "other").
-TURNED_CONFIDENCE_GAIN = 0.25
-
-
-def half_turned(graph: JointGraph) -> JointGraph:
-    """The graph of the character turned half a turn about the vertical axis
-    through its box centre (x = y = 0 of the normalised frame): the x and y
-    of every position and direction change sign; depths and edges stay."""
-    flip = np.ones(graph.vertex_features.shape[1], dtype=graph.vertex_features.dtype)
-    for start in VERTEX_VECTORS:
-        flip[start:start + 2] = -1
-    return replace(graph, vertices=graph.vertices * np.array([-1.0, -1.0, 1.0]),
-                   vertex_features=graph.vertex_features * flip)
-
-
-def from_behind(turned: Landmarks) -> Landmarks:
-    """The landmarks read on the character turned half a turn
-    (:func:`half_turned`), brought back to it as it stands: every point
-    turned back and left and right swapped. Read from behind, a character
-    facing -y looks to the network like one facing it, so it took the
-    character's right for its left; the positions themselves hold."""
-    flip = np.array([-1.0, -1.0, 1.0])
-    return Landmarks({mirror_name(name): np.asarray(point) * flip for name, point in turned.points.items()},
-                     dict(turned.kind_probabilities))
-
-
-#: The toes' cue of which way a biped faces (:func:`toe_reach`): its feet
-#: are the lowest band of this share of its height, its shins the band
-#: between these shares.
-FOOT_BAND = 0.05
-SHIN_BAND = (0.12, 0.25)
-#: A biped whose feet reach this much farther (share of its height) ahead of
-#: its shins than behind faces that way, whatever the landmark network reads;
-#: nearer even, the toes do not tell. Measured on the training humanoids'
-#: proxies as they are, facing -y (2026-11-26): the feet reach farther toward
-#: -y on 175 of 178 (median 0.09, 5th percentile 0.027); at 0.02, 171 say -y,
-#: 2 say +y, 5 do not tell. No network reads this cue, so the training
-#: characters measure it as fairly as new ones.
-TOE_REACH_SURE = 0.02
-
-
-def toe_reach(surface: Mesh) -> float | None:
-    """How much farther a biped's feet reach toward -y than toward +y from
-    the middle of its shins, averaged over its two legs, as a share of its
-    height (positive: it faces -y); None when a leg has no foot or shin.
-    ``surface`` is upright in the normalised frame, its mirror plane across
-    x; the legs are the two sides of it. Toes point forward: a foot reaches
-    farther ahead of the leg above it than its heel does behind."""
-    points, shares = area_centroids(surface.vertices, surface.triangles)
-    heights = points[:, 2] - points[:, 2].min()
-    height = float(heights.max())
-    across = points[:, 0] - 0.5 * (points[:, 0].min() + points[:, 0].max())
-    reaches = []
-    for sign in (1.0, -1.0):
-        side = sign * across > 0.01 * height
-        foot = side & (heights < FOOT_BAND * height)
-        shin = side & (heights > SHIN_BAND[0] * height) & (heights < SHIN_BAND[1] * height)
-        if foot.sum() < 3 or shin.sum() < 3:
-            return None
-        middle = float(np.average(points[shin, 1], weights=shares[shin]))
-        reaches.append((middle - points[foot, 1].min()) - (points[foot, 1].max() - middle))
-    return float(np.mean(reaches)) / max(height, 1e-12)
-
-
-def faces_backward(landmarks: Landmarks, vertices: np.ndarray, turned: Landmarks | None = None,
-                   toes: float | None = None) -> bool:
-    """Whether the character faces +y instead of -y (normalised frame).
-
-    A biped (read so either way) whose toes tell (``toes``, its
-    :func:`toe_reach`, beyond :data:`TOE_REACH_SURE` either way) faces
-    where they point. Otherwise only a clear case counts: the landmark
-    network reads it much more surely as a biped or quadruped when turned
-    half a turn (``turned``, its landmarks on :func:`half_turned`), or a
-    biped's feet reach behind its ankles (``vertices``: the proxy's).
-    The toes come first: the network's readings of bodies unlike its
-    training ones turned 7 validation humanoids facing -y (docs/rigging.md)."""
-    biped = landmarks.kind == BIPED or (turned is not None and turned.kind == BIPED)
-    if biped and toes is not None and abs(toes) > TOE_REACH_SURE:
-        return toes < 0.0
-    if turned is not None and standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN:
-        return True
-    points = landmarks.points
-    if landmarks.kind != BIPED:
-        return False
-    ahead = behind = 0.0
-    for side in (LEFT, RIGHT):
-        ankle = points["ankle" + side]
-        radius = max(0.5 * abs(points["hip" + side][0]), 0.03)
-        foot = vertices[(vertices[:, 2] <= ankle[2]) & (np.abs(vertices[:, 0] - ankle[0]) <= radius)
-                        & (np.abs(vertices[:, 1] - ankle[1]) <= 4.0 * radius)]
-        if len(foot):
-            ahead += max(ankle[1] - float(foot[:, 1].min()), 0.0)
-            behind += max(float(foot[:, 1].max()) - ankle[1], 0.0)
-    return behind > BACKWARD_FEET_RATIO * ahead and behind > 0.0
 
 
 def standard_confidence(landmarks: Landmarks) -> float:

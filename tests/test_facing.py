@@ -1,0 +1,112 @@
+"""Which way a character faces (core/rigging/facing.py): a biped's toes, a
+quadruped's head end, the landmark network's readings both ways, and the
+reading from behind turned back."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.dataset.normalise import normalise
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging.facing import (
+    END_SHARE,
+    FOOT_BAND,
+    HEAD_END_SURE,
+    SHIN_BAND,
+    TOE_REACH_SURE,
+    Facing,
+    facing,
+    from_behind,
+    head_end_rise,
+    toe_reach,
+)
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.core.rigging.standard_skeleton import BIPED, Landmarks
+from autorig_addon.core.types import Mesh
+from geometry_fixtures import box_mesh
+
+
+def boxes(*corners, spacing=0.02) -> Mesh:
+    """One mesh of axis-aligned boxes, each given as (low, high)."""
+    meshes = [box_mesh(low, high, spacing) for low, high in corners]
+    offsets = np.cumsum([0] + [mesh.vertex_count for mesh in meshes[:-1]])
+    return Mesh(np.concatenate([mesh.vertices for mesh in meshes]),
+                np.concatenate([mesh.triangles + offset for mesh, offset in zip(meshes, offsets)]))
+
+
+#: The feet and shins of two legs (x 0.05 to 0.15 each side): each foot from 0.12 ahead of its shin's middle to 0.04
+#: behind it, the shins within the shin band, on a trunk up to a height of 1.
+BIPED_BOXES = [box for sign in (1.0, -1.0) for box in (
+    ([min(sign * 0.05, sign * 0.15), -0.03, 0.13], [max(sign * 0.05, sign * 0.15), 0.03, 0.24]),
+    ([min(sign * 0.05, sign * 0.15), -0.12, 0.0], [max(sign * 0.05, sign * 0.15), 0.04, 0.04]))]
+TRUNK = ([-0.15, -0.05, 0.5], [0.15, 0.05, 1.0])
+
+
+def half_turn(mesh: Mesh) -> Mesh:
+    return Mesh(mesh.vertices * [-1.0, -1.0, 1.0], mesh.triangles)
+
+
+def test_the_toes_reach_is_how_much_farther_the_feet_reach_ahead_of_the_shins_than_behind():
+    assert (FOOT_BAND, SHIN_BAND, TOE_REACH_SURE) == (0.05, (0.12, 0.25), 0.02)
+    body = boxes(*BIPED_BOXES, TRUNK)
+    # Each foot reaches 0.12 ahead of its shin's middle and 0.04 behind: 0.08 of the height toward -y.
+    assert toe_reach(body) == pytest.approx(0.08, abs=1e-12)
+    assert toe_reach(half_turn(body)) == pytest.approx(-0.08, abs=1e-12)
+    # A generated biped facing -y, as the generator makes it, and turned half a turn.
+    character = generate_character(0, BIPED)
+    surface = normalise(character.mesh, character.skeleton).mesh
+    assert toe_reach(surface) > TOE_REACH_SURE
+    assert toe_reach(half_turn(surface)) < -TOE_REACH_SURE
+
+
+def landmarks_of(kind_probabilities: dict) -> Landmarks:
+    return Landmarks({name: np.zeros(3) for name in LANDMARKS}, kind_probabilities)
+
+
+SURE_BIPED = {"biped": 0.95, "quadruped": 0.0, "other": 0.05}
+UNSURE = {"biped": 0.3, "quadruped": 0.0, "other": 0.7}
+
+
+def test_a_bipeds_toes_decide_which_way_it_faces():
+    body = boxes(*BIPED_BOXES, TRUNK)  # toes toward -y
+    assert facing(landmarks_of(SURE_BIPED), landmarks_of(UNSURE), body) == Facing(False)
+    assert facing(landmarks_of(SURE_BIPED), landmarks_of(UNSURE), half_turn(body)) == Facing(
+        True, reason="its toes point toward +Y")
+    # Kept by its toes, though turned it reads far more surely as a biped: that reading is taken, turned back.
+    kept = facing(landmarks_of(UNSURE), landmarks_of(SURE_BIPED), body)
+    assert kept == Facing(False, True, "The character faces -Y (its toes point that way) but reads more surely as "
+                                       "a biped from behind: its landmarks were read from behind and turned back.")
+
+
+def test_without_a_shape_cue_the_surer_reading_turned_decides():
+    # A box has no toes and both its ends stand alike: the landmark network's readings decide.
+    block = boxes(([-0.2, -0.2, 0.0], [0.2, 0.2, 1.0]))
+    assert facing(landmarks_of(UNSURE), landmarks_of(SURE_BIPED), block) == Facing(
+        True, reason="turned, it reads more surely as a biped")
+    assert facing(landmarks_of(UNSURE), landmarks_of(UNSURE), block) == Facing(False)
+
+
+def test_a_quadrupeds_higher_end_is_its_front():
+    assert (END_SHARE, HEAD_END_SURE) == (0.15, 0.05)
+    # A body along y from -0.5 to 0.5: a trunk 0.3 to 0.6 high, a head up to 0.9 at the -y end, four legs.
+    legs = [([x - 0.03, y - 0.03, 0.0], [x + 0.03, y + 0.03, 0.3]) for x in (-0.1, 0.1) for y in (-0.3, 0.3)]
+    animal = boxes(([-0.12, -0.4, 0.3], [0.12, 0.5, 0.6]), ([-0.06, -0.5, 0.6], [0.06, -0.4, 0.9]), *legs)
+    assert head_end_rise(animal) > HEAD_END_SURE
+    assert head_end_rise(half_turn(animal)) == pytest.approx(-head_end_rise(animal), abs=1e-12)
+    sure = {"biped": 0.0, "quadruped": 0.95, "other": 0.05}
+    assert facing(landmarks_of(sure), landmarks_of(UNSURE), animal) == Facing(False)
+    assert facing(landmarks_of(sure), landmarks_of(UNSURE), half_turn(animal)) == Facing(
+        True, reason="its head end is toward +Y")
+
+
+def test_a_reading_from_behind_is_turned_back_with_its_sides_swapped():
+    points = {name: np.zeros(3) for name in LANDMARKS}
+    # Read from behind, the network put a "left" wrist at +x of the turned frame: the character's right hand.
+    points["wrist.L"], points["wrist.R"] = np.array([0.3, 0.02, 0.6]), np.array([-0.3, 0.02, 0.6])
+    points["head"] = np.array([0.0, 0.01, 0.9])
+    turned = Landmarks(points, {"biped": 0.9, "quadruped": 0.0, "other": 0.1})
+    back = from_behind(turned)
+    # Turned back half a turn: its right hand at -x, in front (y -0.02) as the hand was seen from behind.
+    np.testing.assert_allclose(back.points["wrist.R"], [-0.3, -0.02, 0.6])
+    np.testing.assert_allclose(back.points["wrist.L"], [0.3, -0.02, 0.6])
+    np.testing.assert_allclose(back.points["head"], [0.0, -0.01, 0.9])
+    assert set(back.points) == set(LANDMARKS) and back.kind_probabilities == turned.kind_probabilities
