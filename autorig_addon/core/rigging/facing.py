@@ -149,7 +149,7 @@ class Facing:
     ----------
     turn : bool, it faces +y: it is turned half a turn for the prediction
     read_from_behind : bool, it faces -y but is read from behind (:func:`from_behind`)
-    reason : str, what told, for the report ("its toes point toward +Y")
+    reason : str, what told it, for the report ("its toes point toward +Y", "its toes point that way")
     """
 
     turn: bool
@@ -182,9 +182,7 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
         if backward:
             return Facing(True, reason=f"{toward} +Y")
         if surer_turned:
-            return Facing(False, True, f"The character faces -Y ({that_way}) but reads more surely as a "
-                                       f"{turned.kind} from behind: its landmarks were read from behind and "
-                                       "turned back.")
+            return Facing(False, True, that_way)
         return Facing(False)
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"

@@ -233,7 +233,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                      "prediction, so its .L bones lie on its own left.")
     elif way.read_from_behind:
         landmarks = from_behind(turned)
-        notes.append(way.reason)
+        notes.append(f"The character faces -Y ({way.reason}) but reads more surely as a {landmarks.kind} from "
+                     "behind: its landmarks were read from behind and turned back.")
     landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
     report(progress, 0.7, "Running the joint network")
