@@ -20,7 +20,11 @@ Rigify's metarigs, named as :mod:`.role_names` names a recognised body:
   ``front_foot``, ``front_toe``; ``thigh``, ``shin``, ``foot``, ``toe``.
 
 Ends the landmarks do not give (top of the head, snout, feet and toes on
-the ground, hand, tail) are read from the mesh. On a nearly symmetric shape
+the ground, hand, tail) are read from the mesh. A biped's landmarks are
+first set where artists put them, from their conventions on the training
+rigs: the hips no higher than the hip joints, the head joint near the neck,
+each shoulder on its arm's axis and each wrist just past its forearm's
+narrowest section, both read from the mesh. On a nearly symmetric shape
 (:data:`NEAR_SYMMETRIC_ERROR`) left and right landmarks are made mirror
 images of each other (averaged across x = 0) and midline ones put on x = 0,
 so a character a little off symmetric (a held prop, one arm raised a few
