@@ -109,3 +109,15 @@ def test_a_reading_from_behind_is_turned_back_with_its_sides_swapped():
     np.testing.assert_allclose(back.points["wrist.L"], [0.3, -0.02, 0.6])
     np.testing.assert_allclose(back.points["head"], [0.0, -0.01, 0.9])
     assert set(back.points) == set(LANDMARKS) and back.kind_probabilities == turned.kind_probabilities
+
+
+def test_a_zero_area_face_alone_at_an_end_tells_nothing_and_breaks_nothing():
+    # A zero-area triangle standing alone beyond the body's -y end: that end has no area to weigh, so the head-end
+    # cue does not tell (rather than dividing by zero) and the readings decide.
+    block = boxes(([-0.2, -0.2, 0.0], [0.2, 0.2, 1.0]))
+    speck = len(block.vertices)
+    with_speck = Mesh(np.concatenate([block.vertices, [[0.0, -0.5, 0.5]] * 3]),
+                      np.concatenate([block.triangles, [[speck, speck + 1, speck + 2]]]))
+    assert head_end_rise(with_speck) is None
+    sure = {"biped": 0.0, "quadruped": 0.95, "other": 0.05}
+    assert facing(landmarks_of(sure), landmarks_of(UNSURE), with_speck) == Facing(False)

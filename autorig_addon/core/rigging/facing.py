@@ -103,7 +103,7 @@ def toe_reach(surface: Mesh) -> float | None:
         side = sign * across > 0.01 * height
         foot = side & (heights < FOOT_BAND * height)
         shin = side & (heights > SHIN_BAND[0] * height) & (heights < SHIN_BAND[1] * height)
-        if foot.sum() < 3 or shin.sum() < 3:
+        if foot.sum() < 3 or shin.sum() < 3 or shares[shin].sum() <= 0.0:
             return None
         middle = float(np.average(points[shin, 1], weights=shares[shin]))
         reaches.append((middle - points[foot, 1].min()) - (points[foot, 1].max() - middle))
@@ -125,11 +125,12 @@ END_SHARE = 0.15
 HEAD_END_SURE = 0.05
 
 
-def head_end_rise(surface: Mesh) -> float:
+def head_end_rise(surface: Mesh) -> float | None:
     """How much higher the -y end of a body stands than its +y end: the
     difference of the area-weighted mean heights of the surface in the
     :data:`END_SHARE` of its length at each end, as a share of its height
-    (positive: the -y end is the higher, where a quadruped's head is)."""
+    (positive: the -y end is the higher, where a quadruped's head is); None
+    when an end holds no area (a stray zero-area face there)."""
     points, shares = area_centroids(surface.vertices, surface.triangles)
     heights = points[:, 2] - points[:, 2].min()
     along = points[:, 1]
@@ -137,6 +138,8 @@ def head_end_rise(surface: Mesh) -> float:
     length = high - low
     front = along <= low + END_SHARE * length
     back = along >= high - END_SHARE * length
+    if shares[front].sum() <= 0.0 or shares[back].sum() <= 0.0:
+        return None
     rise = np.average(heights[front], weights=shares[front]) - np.average(heights[back], weights=shares[back])
     return float(rise) / max(float(heights.max()), 1e-12)
 
@@ -175,7 +178,7 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
             shape = (toes < 0.0, "its toes point toward", "its toes point that way")
     elif QUADRUPED in kinds:
         rise = head_end_rise(surface)
-        if abs(rise) > HEAD_END_SURE:
+        if rise is not None and abs(rise) > HEAD_END_SURE:
             shape = (rise < 0.0, "its head end is toward", "its head end is that way")
     if shape is not None:
         backward, toward, that_way = shape
