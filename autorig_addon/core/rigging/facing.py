@@ -151,7 +151,9 @@ class Facing:
     Attributes
     ----------
     turn : bool, it faces +y: it is turned half a turn for the prediction
-    read_from_behind : bool, it faces -y but is read from behind (:func:`from_behind`)
+    read_from_behind : bool, facing -y (once turned, if it is), it is read from
+        behind (:func:`from_behind`): the reading of it turned half a turn, or,
+        when it is turned, the reading of it as it was given
     reason : str, what told it, for the report ("its toes point toward +Y", "its toes point that way")
     """
 
@@ -183,10 +185,10 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     if shape is not None:
         backward, toward, that_way = shape
         if backward:
-            return Facing(True, reason=f"{toward} +Y")
-        if surer_turned:
-            return Facing(False, True, that_way)
-        return Facing(False)
+            # Turned to face -y, it is seen from behind as it was given: that reading, if far surer, is the one kept.
+            surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
+            return Facing(True, surer_as_given, f"{toward} +Y")
+        return Facing(False, surer_turned, that_way if surer_turned else "")
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"
         return Facing(True, reason=f"turned, it reads more surely as {kind}")

@@ -226,15 +226,18 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     turned = read_turned(rotation)
     way = facing(landmarks, turned, Mesh(graph.vertices, proxy.triangles))
     if way.turn:
-        # Turned half a turn the character faces -y as the networks expect, its left at +x.
+        # Turned half a turn the character faces -y as the networks expect, its left at +x; seen from behind, it is
+        # now as it was given.
+        turned = landmarks
         rotation = HALF_TURN @ rotation
         transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
                      "prediction, so its .L bones lie on its own left.")
-    elif way.read_from_behind:
+    if way.read_from_behind:
         landmarks = from_behind(turned)
-        notes.append(f"The character faces -Y ({way.reason}) but reads more surely as a {landmarks.kind} from "
-                     "behind: its landmarks were read from behind and turned back.")
+        facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
+        notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
+                     "from behind and turned back.")
     landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
     report(progress, 0.7, "Running the joint network")
