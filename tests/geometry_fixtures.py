@@ -231,3 +231,18 @@ BAD_BONES = [
     ([[0, 0, 0]], [[0, 0, np.inf]], "A bone has a NaN or infinite position; fix the armature first."),
     (np.zeros((2, 3)), np.ones((1, 3)), "Every bone needs one head and one tail."),
 ]
+
+
+def card_strip(top, bottom, width: float, segments: int = 2, two_sided: bool = False) -> Mesh:
+    """A hair card: an open strip ``width`` wide from ``top`` to ``bottom``,
+    ``segments`` quads long, its width along x; ``two_sided``: every face
+    also wound the other way on the same vertices (closed, no volume)."""
+    top, bottom = np.asarray(top, float), np.asarray(bottom, float)
+    centres = top + np.linspace(0.0, 1.0, segments + 1)[:, None] * (bottom - top)
+    half = np.array([width / 2, 0.0, 0.0])
+    vertices = np.stack([centres - half, centres + half], axis=1).reshape(-1, 3)
+    left, right = np.arange(segments) * 2, np.arange(segments) * 2 + 1
+    triangles = np.concatenate([np.stack([left, right, right + 2], 1), np.stack([left, right + 2, left + 2], 1)])
+    if two_sided:
+        triangles = np.concatenate([triangles, triangles[:, ::-1]])
+    return Mesh(vertices, triangles)

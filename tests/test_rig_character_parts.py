@@ -210,3 +210,57 @@ def test_the_rig_command_refuses_a_file_of_two_characters_then_rigs_one_named(cl
     assert item["armature"] == "Ogre_rig" and item["meshes"] == ["Ogre"]
     assert item["notes"][0] == ("'Ground' is flat, under the character and wider than it: left out of the skeleton "
                                 "(a ground plane?)")
+
+
+def hair_cards(count: int = 12):
+    """``count`` hair cards, each an open strip 0.016 wide of two quads, from
+    just off the biped's scalp (around the back half of its head) down to
+    its shoulders: vertices and triangles, as a hair mesh of its own."""
+    character = generate_character(BIPED_SEED, "biped")
+    vertices = character.mesh.vertices
+    head_joint = character.skeleton.joints[list(character.skeleton.names).index("spine.006")]
+    head = vertices[vertices[:, 2] > head_joint[2]]
+    centre, radii = head.mean(axis=0), np.ptp(head, axis=0) / 2
+    points, triangles = [], []
+    for k in range(count):
+        angle = np.pi * (0.15 + 0.7 * k / (count - 1))  # around the back of the head (+y)
+        out = np.array([np.cos(angle), np.sin(angle), 0.0])
+        top = centre + out * radii * 0.85 + [0.0, 0.0, 0.6 * radii[2]]  # the head is 0.8 of its radius wide there
+        bottom = centre + out * radii * 1.15 - [0.0, 0.0, 1.6 * radii[2]]
+        across = np.cross(out, [0.0, 0.0, 1.0]) * 0.008
+        base = len(points)
+        for along in (0.0, 0.5, 1.0):
+            middle = top + along * (bottom - top)
+            points += [middle - across, middle + across]
+        for quad in (base, base + 2):
+            triangles += [[quad, quad + 1, quad + 3], [quad, quad + 3, quad + 2]]
+    return np.array(points), np.array(triangles)
+
+
+def test_hair_cards_follow_the_head(clean_scene):
+    """Twelve cards hanging from the scalp to the shoulders: bound wholly to
+    the head, so turning the head turns them without stretching them. Before,
+    weighted as body, 62 of their 72 vertices were mostly on the chest and
+    the shoulders, and turning the head 45 degrees stretched card edges by up
+    to 29 %."""
+    body = add_biped()
+    hair = mesh_object("Hair", *hair_cards())
+    bpy.context.view_layer.update()
+    select_only([body, hair], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    skeleton = assert_skeleton_within_the_biped(armature)
+    assert {"neck", "head"} <= set(skeleton.names)
+    weights = group_weights(hair, skeleton.names)
+    np.testing.assert_array_equal(weights[:, skeleton.names.index("head")], 1.0)
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-6)
+    rest = evaluated_world_vertices(hair)
+    pose_bone_turned(armature, "head", 45.0, "Y")
+    turned = evaluated_world_vertices(hair)
+    assert np.abs(turned - rest).max() > 0.02  # the hair moved with the head
+    # ... as one piece: every card edge keeps its length (float32 positions).
+    edges = np.array([[a, b] for a, b, c in hair_cards()[1] for a, b in ((a, b), (b, c), (c, a))])
+    lengths = [np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1) for points in (rest, turned)]
+    np.testing.assert_allclose(lengths[1], lengths[0], atol=1e-5)

@@ -28,7 +28,7 @@ from .geometric import geometric_weights
 from .learned.ensemble import ENSEMBLE, ENSEMBLE_DESCRIPTION, ENSEMBLE_LABEL
 from .learned.networks import NETWORK_NAMES, SKIN_NETWORKS
 from .learned.predict import learned_weights
-from .rigid_parts import rigid_weights
+from .rigid_parts import cards_following_the_head, head_columns, rigid_weights
 
 #: The method without training: :func:`.geometric.geometric_weights`.
 GEOMETRIC = "geometric"
@@ -86,7 +86,8 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
     Weights with one column per deform bone (in skeleton order); every row
     is non-negative, sums to 1 and has at most ``options.max_influences``
     non-zeros (when that is above 0). With ``options.rigid_parts``, each
-    loose part the method weighted mostly to one bone is bound wholly to it
+    loose part the method weighted mostly to one bone is bound wholly to it,
+    and each card hanging from the head (hair) is bound wholly to the head
     (:mod:`.rigid_parts`).
 
     Raises
@@ -106,4 +107,5 @@ def skin_weights(mesh: Mesh, skeleton: Skeleton, options, *, progress: ProgressC
                                     **{name: getattr(options, name) for name in GEOMETRIC_OPTIONS})
     if not options.rigid_parts:
         return weights
-    return Weights(rigid_weights(mesh, weights.matrix)[0], weights.bone_names)
+    matrix = rigid_weights(mesh, weights.matrix)[0]
+    return Weights(cards_following_the_head(mesh, matrix, *head_columns(skeleton))[0], weights.bone_names)

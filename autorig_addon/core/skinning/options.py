@@ -45,8 +45,8 @@ class SkinningOptions:
     max_influences : int >= 0, bones kept per vertex (0: no limit)
     smoothing_iterations : int >= 0, extra surface smoothing passes; geometric method only
     smoothing_strength : float in [0, 1], blend factor of one pass; geometric method only
-    rigid_parts : bool, bind each loose part whose weights lie mostly on one bone wholly to it
-        (:mod:`.rigid_parts`); every method
+    rigid_parts : bool, bind each loose part whose weights lie mostly on one bone wholly to it,
+        and cards hanging from the head (hair) to the head (:mod:`.rigid_parts`); every method
     """
 
     method: str = DEFAULT_SKIN_METHOD
@@ -111,7 +111,8 @@ SKINNING_OPTIONS = option_table(*map(_saying_geometric_only, (
            "Blend factor of one smoothing pass", low=0.0, high=1.0, unit=FRACTION),
     Option("rigid_parts", bool, True, "Rigid Loose Parts",
            "Bind each separate piece of the mesh whose weights lie mostly on one bone wholly to that bone "
-           "(a robot's plates, armour pieces, eyes); pieces that span a joint keep their blend"),
+           "(a robot's plates, armour pieces, eyes), and hair cards hanging from the head wholly to the head; "
+           "pieces that span a joint keep their blend"),
     Option("replace_all", bool, False, "Replace All Groups",
            "Remove every existing vertex group of the meshes first (otherwise only the deform bones' groups "
            "are replaced)"),

@@ -10,16 +10,32 @@ whose weights already lie mostly on one bone (at least :data:`RIGID_SHARE`
 of its area-weighted weight) is bound wholly to that bone. A part whose
 weights spread over several bones (a whole leg, a sleeve, trousers, the body
 of a one-piece character) keeps them: it spans a joint and must bend there.
+
+Cards hanging from the head (hair cards, lashes, a beard: thin strips,
+:mod:`...geometry.cards`) move with the head, however far down the back
+they hang: each is bound wholly to the head bone
+(:func:`cards_following_the_head`), unless the armature has bones of its own
+for it below the head (ears, hair chains) that its weights already follow.
+Weighted as body, a card hanging to the shoulders spread over the head, the
+chest and the shoulders, and turning the head tore it at the neck. Artists
+weight them so: of the 346 cards hanging from the head bone in the 416
+cached development characters, 97 % carry the weights of the vertex they
+hang from (mean L1 0.012); of the 117 hanging from other bones
+(fingernails, a skirt's strips, a tail's tassel) only 21 % do, so those keep
+their weights.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.cards import hanging_cards
 from ..geometry.laplacian import voronoi_mass
 from ..geometry.topology import connected_component_labels
 from ..geometry.weld import weld_mesh
-from ..types import Mesh
+from ..skeleton.hierarchy import ancestors
+from ..skeleton.key_joints import key_joints
+from ..types import Mesh, Skeleton
 
 #: A loose part whose area-weighted weights hold at least this share on one
 #: bone is bound wholly to it (see :func:`rigid_weights`). Chosen on every
@@ -69,3 +85,62 @@ def rigid_weights(mesh: Mesh, weights: np.ndarray, share: float = RIGID_SHARE) -
     result[moved] = 0.0
     result[np.flatnonzero(moved), bone[labels[moved]]] = 1.0
     return result, int(np.count_nonzero(rigid))
+
+
+#: Rigify's generated rig prefixes its deforming bones so (``DEF-spine.006``).
+DEFORM_PREFIX = "DEF-"
+#: A card whose weights lie at least this much on bones below the head (ears,
+#: hair chains: bones made for it) keeps them.
+OWN_BONES_SHARE = 0.5
+
+
+def head_columns(skeleton: Skeleton) -> tuple[int | None, np.ndarray]:
+    """The weight column of ``skeleton``'s head bone (its place among the
+    deform bones), read from their names (:func:`...skeleton.key_joints.key_joints`,
+    Rigify's ``DEF-`` prefix dropped), and the columns of the deform bones
+    below it; (None, empty) when no deform bone is the head."""
+    # Deform bones only: Rigify's generated rig also has a control bone called ``head``.
+    deform = np.flatnonzero(skeleton.deform)
+    names = [skeleton.names[index].removeprefix(DEFORM_PREFIX) for index in deform]
+    head = key_joints(names, skeleton.joints[deform]).bones.get("head")
+    if head is None:
+        return None, np.zeros(0, dtype=np.int64)
+    below = [column for column, bone in enumerate(deform) if deform[head] in ancestors(skeleton.parents, bone)]
+    return head, np.asarray(below, dtype=np.int64)
+
+
+def cards_following_the_head(mesh: Mesh, weights: np.ndarray, head: int | None,
+                             below_head: np.ndarray = ()) -> tuple[np.ndarray, int]:
+    """``weights`` with every card hanging from the head (from a vertex
+    weighted mostly to column ``head``) bound wholly to the head, unless the
+    card's own weights lie mostly (:data:`OWN_BONES_SHARE`) on the columns
+    ``below_head``: an armature with bones for it (a rabbit's ears, hair
+    chains) keeps them.
+
+    Parameters
+    ----------
+    mesh : Mesh with n vertices
+    weights : (n, b) array, rows summing to 1 (or 0: unweighted)
+    head : int or None, and below_head : int array (:func:`head_columns`); None changes nothing
+
+    Returns
+    -------
+    (n, b) array and the number of cards bound to the head.
+    """
+    weights = np.asarray(weights, dtype=np.float64)
+    cards = hanging_cards(mesh) if head is not None else None
+    if cards is None or cards.count == 0:
+        return weights, 0
+    roots = weights[cards.hangs_from]
+    on_head = (roots.sum(axis=1) > 0) & (roots.argmax(axis=1) == head)
+    rows = np.flatnonzero(cards.mask)
+    card = cards.card_of_vertex[rows]
+    total = np.bincount(card, weights=weights[rows].sum(axis=1), minlength=cards.count)
+    own = np.bincount(card, weights=weights[rows][:, np.asarray(below_head, dtype=np.int64)].sum(axis=1),
+                      minlength=cards.count)
+    bound = on_head & ~(own >= OWN_BONES_SHARE * np.maximum(total, 1e-300))
+    moved = rows[bound[card]]
+    result = weights.copy()
+    result[moved] = 0.0
+    result[moved, head] = 1.0
+    return result, int(np.count_nonzero(bound))
