@@ -132,3 +132,34 @@ def test_a_body_turned_by_its_shape_keeps_the_reading_it_gave_as_it_was_when_tha
         True, True, "its toes point toward +Y")
     assert facing(landmarks_of(SURE_BIPED), landmarks_of(SURE_BIPED), given) == Facing(
         True, False, "its toes point toward +Y")
+
+
+def quadruped_reading(head_y: float, hips_y: float, probabilities: dict) -> Landmarks:
+    points = {name: np.zeros(3) for name in LANDMARKS}
+    points["head"], points["hips"] = np.array([0.0, head_y, 0.8]), np.array([0.0, hips_y, 0.5])
+    return Landmarks(points, probabilities)
+
+
+def test_a_reading_from_behind_that_puts_a_quadrupeds_head_on_its_tail_is_not_taken():
+    """Kept facing -y by its higher head end and read far more surely turned:
+    that reading is taken only when, turned back, its head lies toward -y of
+    its hips. Before, a validation stegosaurus (its back plates standing
+    highest) was read with its head on the tail tip: every key joint wrong."""
+    legs = [([x - 0.03, y - 0.03, 0.0], [x + 0.03, y + 0.03, 0.3]) for x in (-0.1, 0.1) for y in (-0.3, 0.3)]
+    animal = boxes(([-0.12, -0.4, 0.3], [0.12, 0.5, 0.6]), ([-0.06, -0.5, 0.6], [0.06, -0.4, 0.9]), *legs)
+    unsure = {"biped": 0.0, "quadruped": 0.4, "other": 0.6}
+    sure = {"biped": 0.0, "quadruped": 0.95, "other": 0.05}
+    # Read on the turned body with its head at -y there: turned back, the head lands at +y, the tail end.
+    tail_first = quadruped_reading(-0.45, 0.35, sure)
+    assert from_behind(tail_first).points["head"][1] == pytest.approx(0.45)
+    assert facing(quadruped_reading(-0.45, 0.35, unsure), tail_first, animal) == Facing(False)
+    # Read with its head at +y of the turned body, where the head really is: taken, turned back.
+    head_first = quadruped_reading(0.45, -0.35, sure)
+    assert facing(quadruped_reading(-0.45, 0.35, unsure), head_first, animal) == Facing(
+        False, True, "its head end is that way")
+    # Given facing +y: turned by its head end; the reading as given is the one from behind, and the same holds.
+    given = half_turn(animal)
+    assert facing(tail_first, quadruped_reading(-0.45, 0.35, unsure), given) == Facing(
+        True, False, "its head end is toward +Y")
+    assert facing(head_first, quadruped_reading(-0.45, 0.35, unsure), given) == Facing(
+        True, True, "its head end is toward +Y")

@@ -20,7 +20,8 @@ this order (:func:`facing`):
 A body kept facing -y by its shape that the network reads far more surely
 from behind (one unlike its training characters: the network saw its back
 as a front) takes that reading, turned back with its sides swapped
-(:func:`from_behind`).
+(:func:`from_behind`), unless that reading puts a quadruped's head at the
+other end than its shape does.
 
 Everything here is in the normalised frame (feet at z = 0, largest side 1).
 """
@@ -173,7 +174,7 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     """
     kinds = (landmarks.kind, turned.kind)
     surer_turned = standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN
-    shape = None
+    shape, shape_kind = None, BIPED
     if BIPED in kinds:
         toes = toe_reach(surface)
         if toes is not None and abs(toes) > TOE_REACH_SURE:
@@ -181,20 +182,33 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     elif QUADRUPED in kinds:
         rise = head_end_rise(surface)
         if rise is not None and abs(rise) > HEAD_END_SURE:
-            shape = (rise < 0.0, "its head end is toward", "its head end is that way")
+            shape, shape_kind = (rise < 0.0, "its head end is toward", "its head end is that way"), QUADRUPED
     if shape is not None:
         backward, toward, that_way = shape
         if backward:
             # Turned to face -y, it is seen from behind as it was given: that reading, if far surer, is the one kept.
             surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
-            return Facing(True, surer_as_given, f"{toward} +Y")
-        return Facing(False, surer_turned, that_way if surer_turned else "")
+            return Facing(True, surer_as_given and _keeps_the_head_end(from_behind(landmarks), shape_kind),
+                          f"{toward} +Y")
+        behind = surer_turned and _keeps_the_head_end(from_behind(turned), shape_kind)
+        return Facing(False, behind, that_way if behind else "")
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"
         return Facing(True, reason=f"turned, it reads more surely as {kind}")
     if landmarks.kind == BIPED and _feet_behind_ankles(landmarks, surface.vertices):
         return Facing(True, reason="its feet reach further behind its ankles than ahead")
     return Facing(False)
+
+
+def _keeps_the_head_end(reading: Landmarks, shape_kind: str) -> bool:
+    """Whether a reading from behind (:func:`from_behind`, facing -y) keeps
+    the head where the shape put it: a biped's head is above either way (the
+    reading only swaps its sides); a quadruped's must lie toward -y of its
+    hips, the head end its shape told (:func:`head_end_rise`). Read from
+    behind, a network may take a quadruped's tail end for its head (a
+    stegosaurus, whose back plates stand highest, read with its head on the
+    tail tip) or find its head where it is, only more surely (an elephant)."""
+    return shape_kind != QUADRUPED or bool(reading.points["head"][1] < reading.points["hips"][1])
 
 
 def _feet_behind_ankles(landmarks: Landmarks, vertices: np.ndarray) -> bool:
