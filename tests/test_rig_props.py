@@ -24,6 +24,7 @@ from blender_fixtures import (
     bind,
     evaluated_world_vertices,
     group_weights,
+    local_positions,
     mesh_object,
     parent_to_bone,
     pose_bone_turned,
@@ -150,6 +151,74 @@ def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, cap
     after.pop("objects")
     assert after == before
     assert "'Sword' is held: a rigid prop, left out of the skeleton" in capfd.readouterr().out
+
+
+def add_body_holding_a_joined_sword():
+    """The biped with the sword joined into its mesh (selected both, Ctrl+J): one object."""
+    character = generate_character(BIPED_SEED, "biped").mesh
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    obj = mesh_object("Biped", np.vstack([character.vertices, blade.vertices]),
+                      np.vstack([character.triangles, blade.triangles + character.vertex_count]))
+    bpy.context.view_layer.update()
+    return obj, character.vertex_count
+
+
+def test_a_sword_joined_into_the_body_gets_no_bones_and_is_weighted_wholly_to_the_hand(clean_scene, capfd):
+    """The sword is a loose piece of the body's mesh: left out of the
+    skeleton (the same bones as the biped alone, none near the blade) and
+    weighted wholly to the hand holding it, so posing the hand moves it
+    without bending it. Before, it was skinned as body: 3 of its 232
+    vertices mostly on the forearm, some only 54 % on the hand, and a 30
+    degree hand turn bent it by 7 mm."""
+    alone = add_biped("Alone")
+    select_only([alone], active=alone)
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (skeleton_alone,) = armatures()
+    bones_alone = [bone.name for bone in skeleton_alone.data.bones]
+    joints_alone = convert.read_skeleton(skeleton_alone).joints
+    for obj in (skeleton_alone, alone):
+        bpy.data.objects.remove(obj)
+    body, sword_start = add_body_holding_a_joined_sword()
+    select_only([body], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    skeleton = convert.read_skeleton(armature)
+    assert [bone.name for bone in armature.data.bones] == bones_alone
+    np.testing.assert_allclose(skeleton.joints, joints_alone, atol=1e-6)
+    assert "'Biped': a loose piece of 232 vertices held: bound wholly to bone 'hand.R' (a rigid prop, left out " \
+        "of the skeleton)" in capfd.readouterr().out
+    weights = group_weights(body, skeleton.names)
+    hand = skeleton.names.index("hand.R")
+    assert np.array_equal(weights[sword_start:, hand], np.ones(len(weights) - sword_start))
+    assert not np.delete(weights[sword_start:], hand, axis=1).any()
+    np.testing.assert_allclose(weights[:sword_start].sum(axis=1), 1.0, atol=1e-5)
+    rest = evaluated_world_vertices(body)[sword_start:]
+    pose_bone_turned(armature, "hand.R", 30.0)
+    posed = evaluated_world_vertices(body)[sword_start:]
+    assert np.linalg.norm(posed - rest, axis=1).max() > 0.05
+    np.testing.assert_allclose(pairwise_distances(posed), pairwise_distances(rest), atol=1e-5)
+
+
+def test_predict_skeleton_leaves_a_joined_sword_out_and_the_mesh_untouched(clean_scene, capfd):
+    body, _ = add_body_holding_a_joined_sword()
+    select_only([body], active=body)
+    before = scene_state([body])
+    before.pop("objects")
+
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+
+    (armature,) = armatures()
+    skeleton = convert.read_skeleton(armature)
+    blade = local_positions(body)[-232:]
+    blade = blade[blade[:, 1] < GRIP[1] - BLADE_CLEARANCE]
+    assert point_segment_distances(blade, skeleton.joints, skeleton.tails).min() > BLADE_CLEARANCE - 0.05
+    after = scene_state([body])
+    after.pop("objects")
+    assert after == before
+    assert "'Biped': a loose piece of 232 vertices is held: a rigid prop, left out of the skeleton" \
+        in capfd.readouterr().out
 
 
 def test_a_helmet_and_a_bracer_on_one_arm_are_skinned_not_held(clean_scene, capfd):

@@ -146,6 +146,9 @@ class RigPlan:
     held : tuple of (bpy.types.Object, (3,) float array): rigid props the character holds, not among
         ``meshes`` (``core.rigging.props``), and their grip (world space); Auto-Rig binds each wholly to
         the deform bone nearest to its grip
+    held_pieces : tuple of ((k,) int array, (3,) float array): held rigid props joined into one of
+        ``meshes`` (a sword joined into the body), their rows in ``mesh`` and their grip; left out of
+        the prediction, and Auto-Rig weights each wholly to the deform bone nearest to its grip
     """
 
     meshes: list
@@ -160,11 +163,18 @@ class RigPlan:
     left_out: np.ndarray | None = None
     notes: tuple = ()
     held: tuple = ()
+    held_pieces: tuple = ()
 
     @property
     def character(self) -> Mesh:
-        """The shape the skeleton is predicted for: ``mesh`` without the ``left_out`` vertices."""
-        return self.mesh if self.left_out is None else self.mesh.subset(~self.left_out)
+        """The shape the skeleton is predicted for: ``mesh`` without the ``left_out`` vertices and the
+        ``held_pieces``."""
+        if self.left_out is None and not self.held_pieces:
+            return self.mesh
+        left = np.zeros(self.mesh.vertex_count, dtype=bool) if self.left_out is None else self.left_out.copy()
+        for rows, _ in self.held_pieces:
+            left[rows] = True
+        return self.mesh.subset(~left)
 
 
 @dataclass
@@ -238,7 +248,8 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
     chosen = meshes
-    meshes, mesh, left_out, notes, held = _the_character(chosen, mesh, named=named, bound=skin is not None)
+    meshes, mesh, left_out, notes, held, held_pieces = _the_character(chosen, mesh, named=named,
+                                                                      bound=skin is not None)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
     if skin is not None and not replace:
@@ -251,7 +262,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
                 "it to the new skeleton instead, or remove its Armature modifier first."
             )
     plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
-                   left_out, notes, held)
+                   left_out, notes, held, held_pieces)
     _require_not_flat(meshes, plan.character)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
@@ -277,20 +288,24 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tup
     left_out : (n',) bool array over its vertices, or None when nothing is left out of them
     notes : tuple of str
     held : tuple of (bpy.types.Object, (3,) array), the props held and their grip (see :class:`RigPlan`)
+    held_pieces : tuple of ((k,) int array, (3,) array), the props joined into a mesh: their rows in the
+        returned mesh and their grip (see :class:`RigPlan`)
     """
     parts = character_parts(mesh)
     if parts.several:
         raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
     props = rigid_props(mesh, parts.left_out)
-    dropped = set(parts.whole_objects()) | {prop.object_index for prop in props}
+    dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:
         kept_rows[mesh.object_slice(index)] = False
     left_out = parts.left_out[kept_rows]
     notes = (*left_out_notes(mesh, parts, bound=bound), *prop_notes(mesh, props, bound=bound))
-    held = tuple((meshes[prop.object_index], prop.grip) for prop in props if prop.held)
+    held = tuple((meshes[prop.object_index], prop.grip) for prop in props if prop.held and prop.piece is None)
+    new_row = np.cumsum(kept_rows) - 1
+    held_pieces = tuple((new_row[prop.piece], prop.grip) for prop in props if prop.piece is not None)
     return ([obj for index, obj in enumerate(meshes) if index not in dropped], mesh.subset(kept_rows),
-            left_out if left_out.any() else None, notes, held)
+            left_out if left_out.any() else None, notes, held, held_pieces)
 
 
 def _one_at_a_time(mesh: Mesh, parts: CharacterParts, named: bool) -> str:
@@ -421,7 +436,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                     for obj in bound:
                         unbind(obj)
                 skin_plan = plan_skin(target, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
-                                      named=plan.named, left_out=plan.left_out, held=plan.held)
+                                      named=plan.named, left_out=plan.left_out, held=plan.held,
+                                      held_pieces=plan.held_pieces)
                 weights = yield lambda progress: compute_skin(skin_plan, sub_progress(progress, share, 1.0))
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights

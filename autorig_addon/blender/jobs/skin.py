@@ -32,6 +32,7 @@ from ...core.geometry.outliers import require_finite_positions, rows_for_strays
 from ...core.geometry.outward_faces import inward_faces_note, outward_mesh
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback
+from ...core.rigging.props import held_note, holding_bone, piece_text
 from ...core.skeleton.tails import TailDecision, with_reliable_tails
 from ...core.skinning.methods import SKIN_METHOD_LABELS, check_skin_method, skin_weights
 from ...core.skinning.options import SkinningOptions
@@ -117,6 +118,9 @@ class SkinPlan:
     renames : list of dict, per mesh the artist's groups to keep under a new name (``artist_groups``)
     left_out : (n,) bool array over ``mesh``'s vertices or None, vertices left unweighted
         (Auto-Rig: what is not the character, ``core.rigging.character_parts``)
+    held_pieces : tuple of ((k,) int array, int): props joined into the meshes (Auto-Rig,
+        ``core.rigging.props``), their rows in ``mesh`` and the deform bone (its weight column) that holds
+        them; left out of the computation and weighted wholly to that bone
     """
 
     armature: object
@@ -132,6 +136,7 @@ class SkinPlan:
     rest: convert.RestShape | None = None
     renames: list = field(default_factory=list)
     left_out: np.ndarray | None = None
+    held_pieces: tuple = ()
 
     @property
     def summary(self) -> str:
@@ -153,7 +158,7 @@ def _check_skeleton_fits_mesh(skeleton: Skeleton, mesh: Mesh, armature_name: str
 
 
 def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, named: bool = True,
-              left_out: np.ndarray | None = None, held: Sequence = ()) -> SkinPlan:
+              left_out: np.ndarray | None = None, held: Sequence = (), held_pieces: Sequence = ()) -> SkinPlan:
     """Read and check the inputs; raises :class:`InputError` on bad input.
 
     Parameters
@@ -174,6 +179,9 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         the character holds, not among ``meshes``, and their grip (world
         space, ``core.rigging.props``): each is bound wholly to the deform
         bone nearest to its grip.
+    held_pieces : sequence of ((k,) int array, (3,) array): props Auto-Rig
+        found joined into ``meshes``, their rows in the rest shape and their
+        grip: each is weighted wholly to the deform bone nearest to its grip.
     """
     check_skin_method(settings.options.method)
     convert.require_armature_object(armature)
@@ -217,7 +225,19 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     if left_out is not None and len(left_out) != mesh.vertex_count:
         raise InputError(f"{listed_names([obj.name for obj in meshes], quoted=True)} changed while being rigged: "
                          "run it again.")
-    solved, strays = split_strays(mesh, left_out)
+    deform_names = [name for name, deform in zip(skeleton.names, skeleton.deform) if deform]
+    pieces = []
+    for rows, grip in held_pieces:
+        bone = holding_bone(grip, skeleton)
+        pieces.append((np.asarray(rows, dtype=np.int64), deform_names.index(bone)))
+        owner = mesh.object_names[int(np.searchsorted(mesh.object_offsets, rows[0], side="right") - 1)]
+        notes.append(f"'{owner}': {piece_text(len(rows))} {held_note(bone)}")
+    excluded = left_out
+    if pieces:
+        excluded = np.zeros(mesh.vertex_count, dtype=bool) if left_out is None else left_out.copy()
+        for rows, _ in pieces:
+            excluded[rows] = True
+    solved, strays = split_strays(mesh, excluded)
     if solved.bounding_box_diagonal <= 0:
         raise InputError("The mesh has zero size.")
     if strays is not None:
@@ -231,7 +251,7 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
     skeleton, tail_decision = with_reliable_tails(skeleton, solved.bounding_box_diagonal)
     _check_skeleton_fits_mesh(skeleton.deform_subset(), solved, armature.name)
     return SkinPlan(armature, meshes, mesh, skeleton, settings, tail_decision, strays, solved, rigid, notes,
-                    rest, renames, left_out)
+                    rest, renames, left_out, tuple(pieces))
 
 
 def _placement_note(obj, armature, place: int) -> str:
@@ -255,12 +275,18 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
         names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
         return Weights(np.zeros((0, len(names))), names)
     weights = skin_weights(plan.solved, plan.skeleton, plan.settings.options, progress=progress)
-    if plan.strays is None and plan.left_out is None:
+    if plan.strays is None and plan.left_out is None and not plan.held_pieces:
         return weights
     left_out = plan.left_out if plan.left_out is not None else np.zeros(plan.mesh.vertex_count, dtype=bool)
     strays = plan.strays if plan.strays is not None else np.zeros(plan.mesh.vertex_count, dtype=bool)
-    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, strays | left_out)
+    held = np.zeros(plan.mesh.vertex_count, dtype=bool)
+    for piece, _ in plan.held_pieces:
+        held[piece] = True
+    rows = rows_for_strays(weights.matrix, plan.mesh.vertices, plan.mesh.triangles, strays | left_out | held)
     rows[left_out] = 0.0
+    for piece, column in plan.held_pieces:
+        rows[piece] = 0.0
+        rows[piece, column] = 1.0
     return Weights(rows, weights.bone_names)
 
 
