@@ -74,6 +74,11 @@ def test_cards_hanging_from_the_head_are_bound_wholly_to_it():
     # Every back card vertex on the head alone, down to z = 0.6 where the body is all chest.
     np.testing.assert_array_equal(result[on_back], [[0.0, 1.0, 0.0]] * int(on_back.sum()))
     np.testing.assert_array_equal(result[~on_back], weights[~on_back])
+    # A vertex left unweighted stays so.
+    unweighted = weights.copy()
+    first_card = np.flatnonzero(on_back)[0]
+    unweighted[first_card] = 0.0
+    assert not cards_following_the_head(mesh, unweighted, head=1, below_head=np.array([2]))[0][first_card].any()
     # No head known: nothing changes.
     same, none = cards_following_the_head(mesh, weights, head=None)
     assert none == 0 and np.array_equal(same, weights)
@@ -103,6 +108,13 @@ def test_the_head_column_is_read_among_the_deform_bones_rigify_prefix_dropped():
     skeleton = Skeleton(joints, np.array([-1, 0, 0, 2, 3, 3, 3, 2, 2, 4]), names, joints + [0, 0, 0.1], deform)
     head, below = head_columns(skeleton)
     assert head == 2 and below.tolist() == [7]
+    # As Rigify generates it: DEF-ear.L follows ORG-ear.L, which hangs from ORG-spine.006, not from DEF-spine.006.
+    rigify_names = names[:9] + ("ORG-spine.006", "ORG-ear.L", "DEF-ear.L")
+    rigify_joints = np.vstack([joints[:9], joints[[4, 9, 9]]])
+    rigify_parents = np.array([-1, 0, 0, 2, 3, 3, 3, 2, 2, 0, 9, 10])
+    rigify = Skeleton(rigify_joints, rigify_parents, rigify_names, rigify_joints + [0, 0, 0.1],
+                      np.concatenate([deform[:9], [False, False, True]]))
+    assert head_columns(rigify)[0] == 2 and head_columns(rigify)[1].tolist() == [7]
     plain = Skeleton(joints[2:9], np.array([-1, 0, 1, 1, 1, 0, 0]), ("hips", "neck", "head", "upper_arm.L",
                                                                        "upper_arm.R", "thigh.L", "thigh.R"))
     assert head_columns(plain)[0] == 2 and head_columns(plain)[1].size == 0

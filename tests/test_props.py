@@ -6,7 +6,7 @@ import pytest
 
 from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging.props import MAX_TWINLESS_PIECES, held_note, holding_bone, prop_notes, rigid_props
+from autorig_addon.core.rigging.props import held_note, holding_bone, prop_notes, rigid_props
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh, cylinder
 
@@ -148,15 +148,22 @@ def test_a_body_of_many_pieces_without_twins_tells_no_piece():
     tolerance once 7 or 8 of its pieces are set aside, 3 of them held (two
     at its shoulders, one at the top of its head). Told as props, they were
     left out of the skeleton, whose right forearm then lay outside the body;
-    more than :data:`MAX_TWINLESS_PIECES` pieces without a twin say the plane
-    does not pair them, so none is told."""
+    more than ``MAX_TWINLESS_PIECES`` (3) pieces without a twin say the
+    plane does not pair them, so none is told."""
     character = generate_character(0, "biped").mesh
     vertices = character.vertices
     turn = np.radians(45.0) * (vertices[:, 2] - vertices[:, 2].min()) / np.ptp(vertices[:, 2])
     twisted = np.stack([np.cos(turn) * vertices[:, 0] - np.sin(turn) * vertices[:, 1],
                         np.sin(turn) * vertices[:, 0] + np.cos(turn) * vertices[:, 1], vertices[:, 2]], axis=1)
-    assert MAX_TWINLESS_PIECES == 3
-    assert rigid_props(Mesh(twisted, character.triangles, object_names=("Biped",))) == ()
+    body = Mesh(twisted, character.triangles, object_names=("Biped",))
+    assert rigid_props(body) == ()
+    # Nor is a separate stick told by the plane those pieces' absence let through: told again with whole
+    # objects only, as before pieces were, the twisted body does not mirror. Beside the straight biped it is.
+    beside = stick(x_from=0.25, y=0.0)
+    assert rigid_props(Mesh.concatenate([body, beside])) == ()
+    straight = Mesh(vertices, character.triangles, object_names=("Biped",))
+    (prop,) = rigid_props(Mesh.concatenate([straight, beside]))
+    assert prop.object_index == 1 and prop.piece is None and prop.held
 
 
 def test_left_out_vertices_are_neither_body_nor_prop():

@@ -226,6 +226,9 @@ def plan_skin(armature, meshes: list, settings: SkinSettings, depsgraph, *, name
         raise InputError(f"{listed_names([obj.name for obj in meshes], quoted=True)} changed while being rigged: "
                          "run it again.")
     deform_names = [name for name, deform in zip(skeleton.names, skeleton.deform) if deform]
+    if any(len(rows) == 0 or int(np.max(rows)) >= mesh.vertex_count for rows, _ in held_pieces):
+        raise InputError(f"{listed_names([obj.name for obj in meshes], quoted=True)} changed while being rigged: "
+                         "run it again.")
     pieces = []
     for rows, grip in held_pieces:
         bone = holding_bone(grip, skeleton)
@@ -270,7 +273,8 @@ def compute_skin(plan: SkinPlan, progress: ProgressCallback | None = None) -> We
     """(n, deform bones) weights for every vertex of every mesh; no ``bpy``.
     Far strays are left out of the computation and take the weights of the
     nearest kept vertex (``core.geometry.outliers.rows_for_strays``); the
-    plan's ``left_out`` vertices get rows of zeros."""
+    plan's ``left_out`` vertices get rows of zeros, its ``held_pieces`` a 1
+    on the bone holding them."""
     if plan.mesh is None:
         names = tuple(name for name, deform in zip(plan.skeleton.names, plan.skeleton.deform) if deform)
         return Weights(np.zeros((0, len(names))), names)

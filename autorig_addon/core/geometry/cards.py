@@ -42,7 +42,7 @@ CARD_ELONGATION = 3.0
 #: A closed piece whose volume is under this share of a cube on its mean width
 #: times its length is a two-sided card (a box of equal width and depth has 1).
 CARD_VOLUME_SHARE = 0.05
-#: A card's root lies within this share of the mesh's largest side of the rest of the mesh.
+#: A card's root lies this near the rest of the mesh, as a share of the rest's largest side.
 ATTACH_SHARE = 0.05
 
 
@@ -107,8 +107,8 @@ def hanging_cards(mesh: Mesh) -> HangingCards:
     rest = ~is_card[labels]
     if not is_card.any() or not rest.any():
         return none
-    largest_side = float(np.ptp(V, axis=0).max())
     rest_vertices = np.flatnonzero(rest)
+    largest_side = float(np.ptp(V[rest_vertices], axis=0).max())
     gap, nearest = cKDTree(V[rest_vertices]).query(V[~rest])
     card_vertices = np.flatnonzero(~rest)
     attached = gap <= ATTACH_SHARE * largest_side

@@ -150,12 +150,26 @@ def rigid_props(mesh: Mesh, left_out: np.ndarray | None = None) -> tuple[Prop, .
     kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
     triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)] if len(mesh.triangles) else mesh.triangles
     triangles = triangles[triangle_double_areas(vertices, triangles) > 0]
-    group_of_vertex, group_object = _groups(mesh, triangles)
+    # Pieces first; where more of them lack a twin than a character holds, they are no props and the
+    # plane their absence let through is not trusted: told again with whole objects only, as before pieces.
+    told = _told(mesh, triangles, kept, *_groups(mesh, triangles, pieces=True))
+    if told is None:
+        told = _told(mesh, triangles, kept, *_groups(mesh, triangles, pieces=False))
+    return told or ()
+
+
+def _told(mesh: Mesh, triangles: np.ndarray, kept: np.ndarray, group_of_vertex: np.ndarray,
+          group_object: np.ndarray) -> tuple[Prop, ...] | None:
+    """The props among the groups (:func:`_groups`) of ``mesh``'s ``triangles``;
+    None when more than :data:`MAX_TWINLESS_PIECES` pieces lack a twin (or
+    together hold :data:`PROP_AREA_SHARE` of the rest's area)."""
+    vertices = mesh.vertices
     owner = group_of_vertex[triangles[:, 0]]
     if len(np.unique(owner)) < 2:
         return ()
+    whole_groups = sum(1 for index in np.unique(owner) if group_object[index] >= 0)
     objects = _Objects(vertices, {int(index): triangles[owner == index] for index in np.unique(owner)},
-                       cKDTree(surface_points(vertices, triangles, SURFACE_SAMPLES)))
+                       cKDTree(surface_points(vertices, triangles, SURFACE_SAMPLES)), whole_groups)
     area = {index: 0.5 * float(triangle_double_areas(vertices, own).sum()) for index, own in objects.own.items()}
     total_area = sum(area.values())
     # An object with pieces left out (a stray speck in it) is not bound whole: it is never a prop.
@@ -167,16 +181,16 @@ def rigid_props(mesh: Mesh, left_out: np.ndarray | None = None) -> tuple[Prop, .
     # Only a symmetric body tells twins from twinless parts (the objects told with it may have made it lopsided).
     tellings = {}
     for axis in (0, 1):
-        told = _twinless(objects, small, axis)
-        if told is not None and told[0] <= SYMMETRY_TOLERANCE:
-            tellings[axis] = told[1]
+        telling = _twinless(objects, small, axis)
+        if telling is not None and telling[0] <= SYMMETRY_TOLERANCE:
+            tellings[axis] = telling[1]
     if len(tellings) == 2:
         tellings = _mirror_planes(objects, tellings)
     candidates = set.intersection(*tellings.values()) if tellings else set()
     pieces = {index for index in candidates if group_object[index] < 0}
-    if len(pieces) > MAX_TWINLESS_PIECES or sum(area[index] for index in pieces) >= PROP_AREA_SHARE * (
-            total_area - sum(area[index] for index in pieces)):
-        candidates -= pieces  # many loose parts without twins: the plane does not pair them (a mech, a twisted body)
+    piece_area = sum(area[index] for index in pieces)
+    if len(pieces) > MAX_TWINLESS_PIECES or (pieces and piece_area >= PROP_AREA_SHARE * (total_area - piece_area)):
+        return None  # many loose parts without twins: the plane does not pair them (a mech, a twisted body)
     if not candidates:
         return ()
     body = objects.triangles_without(candidates)
@@ -194,19 +208,19 @@ def rigid_props(mesh: Mesh, left_out: np.ndarray | None = None) -> tuple[Prop, .
         grip = points[touching].mean(axis=0) if touching.any() else points[np.argmin(distances)]
         if group_object[index] >= 0:
             props.append(Prop(int(group_object[index]), grip, gap, gap <= near))
-        else:
+        elif gap <= near:
+            # A piece far from the body is part of something held (a weapon's spikes) or of the body: it stays.
             rows = np.flatnonzero(group_of_vertex == index)
             object_index = int(np.searchsorted(mesh.object_offsets, rows[0], side="right") - 1)
-            props.append(Prop(object_index, grip, gap, gap <= near, rows))
-    # A piece far from the body is part of something held (a weapon's spikes) or of the body: it stays.
-    props = [prop for prop in props if prop.piece is None or prop.held]
+            props.append(Prop(object_index, grip, gap, True, rows))
     return tuple(sorted(props, key=lambda prop: prop.object_index))
 
 
-def _groups(mesh: Mesh, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _groups(mesh: Mesh, triangles: np.ndarray, pieces: bool) -> tuple[np.ndarray, np.ndarray]:
     """What may be a prop: each object small enough to be one (:data:`PROP_AREA_SHARE`
-    of the others) as a whole, and each loose piece (faces joined by edges,
-    seams welded) of the larger objects (a sword joined into the body's mesh).
+    of the others) as a whole, and with ``pieces`` each loose piece (faces
+    joined by edges, seams welded) of the larger objects (a sword joined into
+    the body's mesh); without, every object whole.
 
     Returns
     -------
@@ -217,7 +231,8 @@ def _groups(mesh: Mesh, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     double_areas = triangle_double_areas(mesh.vertices, triangles)
     object_area = np.bincount(vertex_object[triangles[:, 0]], weights=double_areas,
                               minlength=len(mesh.object_names))
-    small_object = object_area < PROP_AREA_SHARE * (object_area.sum() - object_area)
+    small_object = object_area < PROP_AREA_SHARE * (object_area.sum() - object_area) if pieces else \
+        np.ones(len(mesh.object_names), dtype=bool)
     welded, _, to_welded = weld_vertices(mesh.vertices, triangles, seam_tolerance(mesh))
     piece = connected_component_labels(to_welded[triangles], len(welded))[to_welded]
     objects = len(mesh.object_names)
@@ -233,20 +248,27 @@ def _groups(mesh: Mesh, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass
 class _Objects:
-    """The objects of a mesh with an area: (m_i, 3) triangles of each
-    (``own``, by object index), points drawn on each (``samples``:
-    :data:`SAMPLES_PER_OBJECT`, fewer when there are many objects, down to
-    :data:`FEWEST_SAMPLES`) and a tree of :data:`SURFACE_SAMPLES` points
-    drawn on them all (``surface``)."""
+    """The objects of a mesh with an area (or its groups, :func:`_groups`:
+    whole objects first, ``whole_objects`` of them, then pieces): (m_i, 3)
+    triangles of each (``own``, by group index), points drawn on each
+    (``samples``: :data:`SAMPLES_PER_OBJECT`, fewer when there are many
+    objects, down to :data:`FEWEST_SAMPLES`) and a tree of
+    :data:`SURFACE_SAMPLES` points drawn on them all (``surface``)."""
 
     vertices: np.ndarray
     own: dict
     surface: cKDTree
+    whole_objects: int | None = None
     samples: dict = field(init=False)
 
     def __post_init__(self):
-        count = max(FEWEST_SAMPLES, min(SAMPLES_PER_OBJECT, SAMPLE_BUDGET // len(self.own)))
-        self.samples = {index: surface_points(self.vertices, own, count) for index, own in self.own.items()}
+        # Whole objects share the budget among themselves, so many small pieces of a big one (hair cards joined
+        # into the body) do not thin the points of a separate sword; the first ``whole_objects`` groups are whole.
+        whole = len(self.own) if self.whole_objects is None else self.whole_objects
+        for_whole = max(FEWEST_SAMPLES, min(SAMPLES_PER_OBJECT, SAMPLE_BUDGET // max(whole, 1)))
+        for_piece = max(FEWEST_SAMPLES, min(SAMPLES_PER_OBJECT, SAMPLE_BUDGET // max(len(self.own) - whole, 1)))
+        self.samples = {index: surface_points(self.vertices, own, for_whole if rank < whole else for_piece)
+                        for rank, (index, own) in enumerate(sorted(self.own.items()))}
 
     def triangles_without(self, left: set) -> np.ndarray:
         """(m, 3) the triangles of the objects not in ``left`` (empty for none)."""

@@ -87,8 +87,10 @@ def rigid_weights(mesh: Mesh, weights: np.ndarray, share: float = RIGID_SHARE) -
     return result, int(np.count_nonzero(rigid))
 
 
-#: Rigify's generated rig prefixes its deforming bones so (``DEF-spine.006``).
+#: Rigify's generated rig prefixes its deforming bones so (``DEF-spine.006``) ...
 DEFORM_PREFIX = "DEF-"
+#: ... and the bones they follow so (``ORG-spine.006``, ``MCH-...``).
+RIGIFY_PREFIXES = (DEFORM_PREFIX, "ORG-", "MCH-")
 #: A card whose weights lie at least this much on bones below the head (ears,
 #: hair chains: bones made for it) keeps them.
 OWN_BONES_SHARE = 0.5
@@ -105,14 +107,25 @@ def head_columns(skeleton: Skeleton) -> tuple[int | None, np.ndarray]:
     head = key_joints(names, skeleton.joints[deform]).bones.get("head")
     if head is None:
         return None, np.zeros(0, dtype=np.int64)
-    below = [column for column, bone in enumerate(deform) if deform[head] in ancestors(skeleton.parents, bone)]
+    # By name: Rigify parents each DEF- bone to its ORG- or MCH- bone, so DEF-ear.L hangs from ORG-spine.006.
+    head_name = _plain(names[head])
+    below = [column for column, bone in enumerate(deform)
+             if any(_plain(skeleton.names[above]) == head_name for above in ancestors(skeleton.parents, bone))]
     return head, np.asarray(below, dtype=np.int64)
+
+
+def _plain(name: str) -> str:
+    """A bone name without Rigify's prefixes (``DEF-``, ``ORG-``, ``MCH-``)."""
+    for prefix in RIGIFY_PREFIXES:
+        if name.startswith(prefix):
+            return name[len(prefix):]
+    return name
 
 
 def cards_following_the_head(mesh: Mesh, weights: np.ndarray, head: int | None,
                              below_head: np.ndarray = ()) -> tuple[np.ndarray, int]:
     """``weights`` with every card hanging from the head (from a vertex
-    weighted mostly to column ``head``) bound wholly to the head, unless the
+    whose largest weight is on column ``head``) bound wholly to the head, unless the
     card's own weights lie mostly (:data:`OWN_BONES_SHARE`) on the columns
     ``below_head``: an armature with bones for it (a rabbit's ears, hair
     chains) keeps them.
@@ -139,7 +152,8 @@ def cards_following_the_head(mesh: Mesh, weights: np.ndarray, head: int | None,
     own = np.bincount(card, weights=weights[rows][:, np.asarray(below_head, dtype=np.int64)].sum(axis=1),
                       minlength=cards.count)
     bound = on_head & ~(own >= OWN_BONES_SHARE * np.maximum(total, 1e-300))
-    moved = rows[bound[card]]
+    # A vertex left unweighted (its row zero) stays so, as rigid_weights keeps it.
+    moved = rows[bound[card] & (weights[rows].sum(axis=1) > 0)]
     result = weights.copy()
     result[moved] = 0.0
     result[moved, head] = 1.0
