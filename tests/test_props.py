@@ -6,7 +6,7 @@ import pytest
 
 from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging.props import held_note, holding_bone, prop_notes, rigid_props
+from autorig_addon.core.rigging.props import carried_props, held_note, holding_bone, prop_notes, rigid_props
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh, cylinder
 
@@ -164,6 +164,27 @@ def test_a_body_of_many_pieces_without_twins_tells_no_piece():
     straight = Mesh(vertices, character.triangles, object_names=("Biped",))
     (prop,) = rigid_props(Mesh.concatenate([straight, beside]))
     assert prop.object_index == 1 and prop.piece is None and prop.held
+
+
+def test_what_a_replaced_rig_carried_on_a_bone_and_sticks_out_is_a_held_prop_twin_or_not():
+    """A stick in each hand, mirrored (each the other's twin, so not told by
+    shape), carried by the old rig's hand bones: both held props, gripped at
+    those bones. A shell lying on the body carried by a bone (a helmet)
+    stays the body; a mesh of carried parts only has no body to tell them from."""
+    twin = Mesh(stick().vertices * [-1.0, 1.0, 1.0], stick().triangles[:, ::-1], object_names=("Stick.001",))
+    rows = body().vertices[:, 2] > 0.8
+    helmet = shell(body(), rows, "Helmet", 0.01)
+    mesh = Mesh.concatenate([body(), stick(), twin, helmet])
+    assert rigid_props(mesh) == ()
+    grips = {1: np.array([0.2, 0.1, 0.52]), 2: np.array([-0.2, 0.1, 0.52]), 3: np.array([0.0, 0.0, 0.9])}
+
+    props = carried_props(mesh, grips)
+
+    assert [prop.object_index for prop in props] == [1, 2] and all(prop.held for prop in props)
+    np.testing.assert_array_equal(props[0].grip, grips[1])
+    np.testing.assert_array_equal(props[1].grip, grips[2])
+    assert props[0].gap < 1e-3  # it enters the body
+    assert carried_props(Mesh.concatenate([stick(), twin]), {0: grips[1], 1: grips[2]}) == ()
 
 
 def test_left_out_vertices_are_neither_body_nor_prop():

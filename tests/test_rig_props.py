@@ -302,3 +302,49 @@ def test_the_rig_command_replacing_a_posed_rig_takes_the_sword_from_its_bone_whe
     np.testing.assert_allclose(evaluated_world_vertices(sword), box_mesh(SWORD_LOW, SWORD_HIGH, 0.02).vertices,
                                atol=1e-5)
     assert_bound_wholly_to(sword, armature, "hand.R")
+
+
+def test_the_rig_command_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_as_props(
+        clean_scene, tmp_path, capsys):
+    """A sword in each hand, mirrored, each parented to its hand's bone of
+    the file's rig, the body skinned to it (KayKit's knight with its off-hand
+    sword). Each is the other's twin, so their shapes do not tell them from
+    the body; the rig carrying them on its hand bones does: ``--replace``
+    leaves both out of the skeleton (the bones of the biped alone) and binds
+    each wholly to its hand. Before, both were skinned with the body, as part
+    of it."""
+    character = generate_character(BIPED_SEED, "biped")
+    alone = add_biped("Alone")
+    select_only([alone], active=alone)
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (skeleton_alone,) = armatures()
+    bones_alone = [bone.name for bone in skeleton_alone.data.bones]
+    for obj in (skeleton_alone, alone):
+        bpy.data.objects.remove(obj)
+    body, sword = add_biped(), add_sword()
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
+    bpy.context.view_layer.update()
+    old_rig = build_armature(character.skeleton, "Rig", bpy.context)
+    bind(body, old_rig)
+    parent_to_bone(sword, old_rig, "hand.R")
+    parent_to_bone(offhand, old_rig, "hand.L")
+    source, out = tmp_path / "two_swords.blend", tmp_path / "out"
+    scene_io.save_scene(source)
+    capsys.readouterr()
+
+    code = main(["rig", str(source), "--out", str(out), "--replace", "--quiet"])
+
+    assert code == 0
+    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    assert item["meshes"] == ["Biped"] and item["template"] == "biped"
+    for name, bone in (("Sword", "hand.R"), ("Sword_Offhand", "hand.L")):
+        assert f"'{name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" \
+            in item["notes"]
+    scene_io.load_scene(out / "two_swords.blend")
+    armature = bpy.data.objects[item["armature"]]
+    assert [bone.name for bone in armature.data.bones] == bones_alone
+    assert_bound_wholly_to(bpy.data.objects["Sword"], armature, "hand.R")
+    skeleton = convert.read_skeleton(armature)
+    weights = group_weights(bpy.data.objects["Sword_Offhand"], skeleton.names)
+    assert np.array_equal(weights[:, skeleton.names.index("hand.L")], np.ones(len(weights)))

@@ -10,7 +10,9 @@ no bones: they are bound wholly to the bone holding them
 armature is refused unless ``--replace``, which removes the armatures, the
 meshes' Armature modifiers and the vertex groups named after their bones
 first, and takes what the bones carried (KayKit's swords) off them where it
-is at rest. The options are made from the rig option table
+is at rest; what a bone carried that sticks out of the skinned meshes is a
+held prop by the artist's own rig, twin or not (a sword in each hand), bound
+wholly to the new bone nearest the old one. The options are made from the rig option table
 (``core.rigging.options.RIG_OPTIONS``), the one the Blender panel is made
 from; ``--skin`` takes the skinning methods of ``core.skinning.methods``.
 """
@@ -60,10 +62,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "and their groups named after its bones first (default: such a file is refused)")
 
 
-def clear_armatures(replace: bool) -> list[str]:
+def clear_armatures(replace: bool) -> tuple[list[str], dict]:
     """Remove every armature of the loaded file and unbind the meshes from
-    them when ``replace``; otherwise refuse a file that holds one. Returns
-    the names of the removed armatures."""
+    them when ``replace``; otherwise refuse a file that holds one.
+
+    Returns
+    -------
+    names : the names of the removed armatures
+    carried : dict mapping each mesh an armature that deformed other meshes
+        carried on one bone (KayKit's weapons, shields, helmet, cape) to that
+        bone's head at rest, world space: ``plan_rig``'s ``carried``
+    """
     import bpy
 
     from ..blender.armature_binding import clear_parent_keep_world, pose_position, remove_armature, unbind
@@ -71,7 +80,7 @@ def clear_armatures(replace: bool) -> list[str]:
 
     armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
     if not armatures:
-        return []
+        return [], {}
     names = [obj.name for obj in armatures]
     if not replace:
         raise InputError(f"The file already holds an armature ({listed_names(names, quoted=True)}): pass --replace "
@@ -79,6 +88,11 @@ def clear_armatures(replace: bool) -> list[str]:
     # At rest: the unbound meshes take their rest shape, so what the bones carried (a sword on the hand's bone)
     # must stay where it is at rest too, not where the file's pose held it.
     with pose_position(armatures):
+        deforming = {modifier.object for obj in file_meshes() for modifier in obj.modifiers
+                     if modifier.type == "ARMATURE" and modifier.object in armatures}
+        carried = {obj: _bone_head(obj.parent, obj.parent_bone) for obj in file_meshes()
+                   if obj.parent in deforming and obj.parent_type == "BONE" and obj.parent_bone in obj.parent.data.bones
+                   and not any(modifier.type == "ARMATURE" for modifier in obj.modifiers)}
         for obj in file_meshes():
             unbind(obj)
         for obj in bpy.data.objects:
@@ -86,7 +100,16 @@ def clear_armatures(replace: bool) -> list[str]:
                 clear_parent_keep_world(obj)
     for armature in armatures:
         remove_armature(armature)
-    return names
+    return names, carried
+
+
+def _bone_head(armature, bone_name: str):
+    """(3,) world position of a bone's head at rest (a hand slot's: in the palm; a chest bone's: mid-torso,
+    nearer the new chest than its tail at the neck is)."""
+    import numpy as np
+
+    bone = armature.data.bones[bone_name]
+    return np.array(armature.matrix_world @ bone.head_local, dtype=np.float64)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -110,13 +133,14 @@ def run(args: argparse.Namespace) -> int:
         named = names_in(args.mesh)
         # Helpers (bone shapes) are told apart while their armature is still there.
         meshes = [find_object(name, "MESH") for name in named] if named else without_helpers(file_meshes())
-        removed = clear_armatures(args.replace)
+        removed, carried = clear_armatures(args.replace)
         if not meshes:
             raise InputError("The file holds no mesh to rig.")
         # Named meshes are one character of the file: the armature takes the first one's name.
         character = meshes[0].name if named else Path(input_path).stem
         plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), character, settings,
-                        skin=skin, named=bool(named), rigify=args.rigify, keep_poor=args.keep_poor)
+                        skin=skin, named=bool(named), rigify=args.rigify, keep_poor=args.keep_poor,
+                        carried=carried)
         result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)

@@ -50,7 +50,7 @@ from ...core.rigging.predict import (
     skeleton_quality,
     template_notes,
 )
-from ...core.rigging.props import prop_notes, rigid_props
+from ...core.rigging.props import carried_props, prop_notes, rigid_props
 from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
 from ...core.skeleton.name_presets import DEFAULT_PRESET
@@ -213,7 +213,7 @@ _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
              skin: SkinSettings | None = None, replace: bool = False, named: bool = True,
-             rigify: bool = False, keep_poor: bool = False) -> RigPlan:
+             rigify: bool = False, keep_poor: bool = False, carried: dict | None = None) -> RigPlan:
     """Read and check the character's meshes; raises :class:`InputError` on bad input.
 
     What is not the character (``core.rigging.character_parts``) is told
@@ -234,6 +234,10 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
         already bound to an armature is refused unless ``replace``
     replace : bool
     named, rigify, keep_poor : bool, see :class:`RigPlan`
+    carried : dict or None, mapping meshes a replaced armature carried on one bone each (the ``rig``
+        command's ``--replace``: KayKit's weapons on their hand slots) to that bone's head at rest (world
+        space): those sticking out of the rest are held props (``core.rigging.props.carried_props``), a
+        mirrored pair too
     """
     meshes = list(dict.fromkeys(meshes))
     if not meshes:
@@ -249,7 +253,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
     chosen = meshes
     meshes, mesh, left_out, notes, held, held_pieces = _the_character(chosen, mesh, named=named,
-                                                                      bound=skin is not None)
+                                                                      bound=skin is not None, carried=carried)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
     if skin is not None and not replace:
@@ -269,7 +273,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     return plan
 
 
-def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tuple:
+def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carried: dict | None = None) -> tuple:
     """Tell the character from what is not (``core.rigging.character_parts``,
     ``core.rigging.props``): refuse several characters, naming them; leave
     out a ground plane, stray specks and rigid props.
@@ -280,6 +284,7 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tup
     mesh : Mesh, their rest shape (objects in the order of ``meshes``)
     named : bool, see :class:`RigPlan`
     bound : bool, the run binds the meshes (the notes say what is left unbound)
+    carried : dict or None, see :func:`plan_rig`
 
     Returns
     -------
@@ -294,7 +299,10 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool) -> tup
     parts = character_parts(mesh)
     if parts.several:
         raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
-    props = rigid_props(mesh, parts.left_out)
+    on_bones = {index: carried[obj] for index, obj in enumerate(meshes) if carried and obj in carried}
+    told = carried_props(mesh, on_bones) if on_bones else ()
+    props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
+                  if prop.object_index not in {known.object_index for known in told}) + told
     dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:

@@ -216,6 +216,44 @@ def _told(mesh: Mesh, triangles: np.ndarray, kept: np.ndarray, group_of_vertex: 
     return tuple(sorted(props, key=lambda prop: prop.object_index))
 
 
+def carried_props(mesh: Mesh, carried: dict) -> tuple[Prop, ...]:
+    """The objects a replaced rig carried on one bone each that stick out of
+    the rest (the artist's own word that they are props, twin or not: a
+    sword in each hand, a shield), as held props gripped at that bone.
+
+    Parameters
+    ----------
+    mesh : Mesh, world space, one or more objects
+    carried : dict mapping an object index to the (3,) world point of the bone
+        that carried it (its head at rest)
+
+    Returns
+    -------
+    tuple of Prop (``held`` set, ``grip`` the bone's point), in the objects' order:
+    those over :data:`OUT_SHARE` of whose area lies farther than
+    :data:`NEAR_SHARE` of the rest's largest side from the rest's surface. A
+    helmet or a cape lying on the body stays part of it; nothing is told when
+    every object was carried (a robot of parts on bones is its parts).
+    """
+    vertices = mesh.vertices
+    triangles = mesh.triangles[triangle_double_areas(vertices, mesh.triangles) > 0]
+    owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
+    rest = triangles[~np.isin(owner, list(carried))]
+    if not len(rest):
+        return ()
+    near = NEAR_SHARE * largest_side(vertices[np.unique(rest)])
+    query = TriangleMeshQuery(vertices, rest)
+    props = []
+    for index in sorted(carried):
+        own = triangles[owner == index]
+        if not len(own):
+            continue
+        distances = query.closest(surface_points(vertices, own, SAMPLES_PER_OBJECT)).distances
+        if np.mean(distances > near) > OUT_SHARE:
+            props.append(Prop(int(index), np.asarray(carried[index], dtype=np.float64), float(distances.min()), True))
+    return tuple(props)
+
+
 def _groups(mesh: Mesh, triangles: np.ndarray, pieces: bool) -> tuple[np.ndarray, np.ndarray]:
     """What may be a prop: each object small enough to be one (:data:`PROP_AREA_SHARE`
     of the others) as a whole, and with ``pieces`` each loose piece (faces
