@@ -348,3 +348,33 @@ def test_the_rig_command_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand
     skeleton = convert.read_skeleton(armature)
     weights = group_weights(bpy.data.objects["Sword_Offhand"], skeleton.names)
     assert np.array_equal(weights[:, skeleton.names.index("hand.L")], np.ones(len(weights)))
+
+
+def test_auto_rig_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_as_props(clean_scene, capfd):
+    """The same in the panel: the body bound to the file's rig, a mirrored
+    sword on each hand's bone, all three selected, Auto-Rig with *Replace
+    Binding*: the rig being replaced says what it carried, so both swords
+    are held props bound wholly to the new hands; the old rig goes (nothing
+    follows it any more)."""
+    character = generate_character(BIPED_SEED, "biped")
+    body, sword = add_biped(), add_sword()
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
+    bpy.context.view_layer.update()
+    old_rig = build_armature(character.skeleton, "Rig", bpy.context)
+    bind(body, old_rig)
+    parent_to_bone(sword, old_rig, "hand.R")
+    parent_to_bone(offhand, old_rig, "hand.L")
+    select_only([body, sword, offhand], active=body)
+
+    assert bpy.ops.autorig.auto_rig(rig_replace=True) == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert armature.name == "Biped_rig"
+    out = capfd.readouterr().out
+    for name, bone in (("Sword", "hand.R"), ("Sword_Offhand", "hand.L")):
+        assert f"'{name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
+    assert_bound_wholly_to(sword, armature, "hand.R")
+    skeleton = convert.read_skeleton(armature)
+    weights = group_weights(offhand, skeleton.names)
+    assert np.array_equal(weights[:, skeleton.names.index("hand.L")], np.ones(len(weights)))

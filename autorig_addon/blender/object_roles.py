@@ -104,6 +104,28 @@ def held_binding(obj, armature, grip, skeleton: Skeleton) -> RigidBinding:
     return RigidBinding(obj, armature, holding_bone(grip, skeleton), rest_world, held=True)
 
 
+def carried_on_bones(objects: list) -> dict:
+    """The objects of ``objects`` an armature carries on one bone (parented
+    to it, no Armature modifier) while it deforms another of ``objects``:
+    the props of the artist's own rig (KayKit's weapons on their hand slots),
+    each mapped to the head of its bone at rest, world space (a hand slot's
+    lies in the palm). A rig made of parts on bones alone (a robot) deforms
+    none of them and carries no props."""
+    import numpy as np
+
+    deforming = {modifier.object for obj in objects for modifier in obj.modifiers
+                 if modifier.type == "ARMATURE" and modifier.object is not None}
+    carried = {}
+    for obj in objects:
+        bone = bone_parent(obj)
+        if bone is None or obj.parent not in deforming or bone not in obj.parent.data.bones or \
+                any(modifier.type == "ARMATURE" for modifier in obj.modifiers):
+            continue
+        head = obj.parent.matrix_world @ obj.parent.data.bones[bone].head_local
+        carried[obj] = np.array(head, dtype=np.float64)
+    return carried
+
+
 def split_bone_parented(objects: list, armature, named: bool) -> tuple[list, list, list]:
     """Split ``objects`` into (plain meshes, rigid bindings, props left rigid).
 

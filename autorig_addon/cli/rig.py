@@ -71,11 +71,13 @@ def clear_armatures(replace: bool) -> tuple[list[str], dict]:
     names : the names of the removed armatures
     carried : dict mapping each mesh an armature that deformed other meshes
         carried on one bone (KayKit's weapons, shields, helmet, cape) to that
-        bone's head at rest, world space: ``plan_rig``'s ``carried``
+        bone's head at rest, world space (``blender.object_roles.carried_on_bones``):
+        ``plan_rig``'s ``carried``
     """
     import bpy
 
     from ..blender.armature_binding import clear_parent_keep_world, pose_position, remove_armature, unbind
+    from ..blender.object_roles import carried_on_bones
     from ..blender.selection import file_meshes
 
     armatures = [obj for obj in bpy.data.objects if obj.type == "ARMATURE"]
@@ -87,12 +89,8 @@ def clear_armatures(replace: bool) -> tuple[list[str], dict]:
                          "to remove it and rig the meshes anew.")
     # At rest: the unbound meshes take their rest shape, so what the bones carried (a sword on the hand's bone)
     # must stay where it is at rest too, not where the file's pose held it.
+    carried = carried_on_bones(file_meshes())
     with pose_position(armatures):
-        deforming = {modifier.object for obj in file_meshes() for modifier in obj.modifiers
-                     if modifier.type == "ARMATURE" and modifier.object in armatures}
-        carried = {obj: _bone_head(obj.parent, obj.parent_bone) for obj in file_meshes()
-                   if obj.parent in deforming and obj.parent_type == "BONE" and obj.parent_bone in obj.parent.data.bones
-                   and not any(modifier.type == "ARMATURE" for modifier in obj.modifiers)}
         for obj in file_meshes():
             unbind(obj)
         for obj in bpy.data.objects:
@@ -101,15 +99,6 @@ def clear_armatures(replace: bool) -> tuple[list[str], dict]:
     for armature in armatures:
         remove_armature(armature)
     return names, carried
-
-
-def _bone_head(armature, bone_name: str):
-    """(3,) world position of a bone's head at rest (a hand slot's: in the palm; a chest bone's: mid-torso,
-    nearer the new chest than its tail at the neck is)."""
-    import numpy as np
-
-    bone = armature.data.bones[bone_name]
-    return np.array(armature.matrix_world @ bone.head_local, dtype=np.float64)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -66,6 +66,7 @@ from ..modifier_stack import (
     binding_place,
     cut_off,
 )
+from ..object_roles import carried_on_bones
 from ..rigify_rig import generate_rigify_rig
 from ..snapshot import restored_on_failure
 from .input_checks import check_mode
@@ -234,10 +235,12 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
         already bound to an armature is refused unless ``replace``
     replace : bool
     named, rigify, keep_poor : bool, see :class:`RigPlan`
-    carried : dict or None, mapping meshes a replaced armature carried on one bone each (the ``rig``
-        command's ``--replace``: KayKit's weapons on their hand slots) to that bone's head at rest (world
-        space): those sticking out of the rest are held props (``core.rigging.props.carried_props``), a
-        mirrored pair too
+    carried : dict or None, mapping meshes a replaced armature carried on one bone each (KayKit's
+        weapons on their hand slots) to that bone's head at rest (world space): those sticking out of the
+        rest are held props (``core.rigging.props.carried_props``), a mirrored pair too. The ``rig``
+        command's ``--replace`` reads it before removing the armatures; with ``replace`` and ``skin``
+        (Auto-Rig's Replace Binding) and none given, it is read from ``meshes``
+        (``object_roles.carried_on_bones``)
     """
     meshes = list(dict.fromkeys(meshes))
     if not meshes:
@@ -245,6 +248,8 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     for obj in meshes:
         convert.require_mesh_object(obj, "mesh to rig")
         check_mode(obj, "rig")
+    if carried is None and replace and skin is not None:
+        carried = carried_on_bones(meshes)  # Replace Binding: the rig being replaced says what it carried
     # The old Armature modifiers go with Replace Binding, and Predict Skeleton binds nothing: the new one's place.
     places = [armature_place(obj) if skin is None or replace else binding_place(obj) for obj in meshes]
     rest = convert.read_rest_shape(meshes, places, depsgraph)
