@@ -153,6 +153,39 @@ def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, cap
     assert "'Sword' is held: a rigid prop, left out of the skeleton" in capfd.readouterr().out
 
 
+def bones_of_the_biped_alone() -> tuple[list, np.ndarray]:
+    """The bone names and joints Predict Skeleton gives the biped with nothing else in the scene (removed after)."""
+    alone = add_biped("Alone")
+    select_only([alone], active=alone)
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (armature,) = armatures()
+    names, joints = [bone.name for bone in armature.data.bones], convert.read_skeleton(armature).joints
+    for obj in (armature, alone):
+        bpy.data.objects.remove(obj)
+    return names, joints
+
+
+def add_body_with_a_sword_in_each_hand_on_a_rig() -> tuple:
+    """KayKit's knight with its off-hand sword: the biped skinned to the file's
+    rig, the sword on its right hand's bone and its mirror image on the left's."""
+    body, sword = add_biped(), add_sword()
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
+    bpy.context.view_layer.update()
+    old_rig = build_armature(generate_character(BIPED_SEED, "biped").skeleton, "Rig", bpy.context)
+    bind(body, old_rig)
+    parent_to_bone(sword, old_rig, "hand.R")
+    parent_to_bone(offhand, old_rig, "hand.L")
+    return body, sword, offhand
+
+
+def assert_wholly_on(obj, armature, bone: str) -> None:
+    """Every vertex of ``obj`` weighs exactly 1 on ``bone``."""
+    skeleton = convert.read_skeleton(armature)
+    weights = group_weights(obj, skeleton.names)
+    assert np.array_equal(weights[:, skeleton.names.index(bone)], np.ones(len(weights)))
+
+
 def add_body_holding_a_joined_sword():
     """The biped with the sword joined into its mesh (selected both, Ctrl+J): one object."""
     character = generate_character(BIPED_SEED, "biped").mesh
@@ -170,14 +203,7 @@ def test_a_sword_joined_into_the_body_gets_no_bones_and_is_weighted_wholly_to_th
     without bending it. Before, it was skinned as body: 3 of its 232
     vertices mostly on the forearm, some only 54 % on the hand, and a 30
     degree hand turn bent it by 7 mm."""
-    alone = add_biped("Alone")
-    select_only([alone], active=alone)
-    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
-    (skeleton_alone,) = armatures()
-    bones_alone = [bone.name for bone in skeleton_alone.data.bones]
-    joints_alone = convert.read_skeleton(skeleton_alone).joints
-    for obj in (skeleton_alone, alone):
-        bpy.data.objects.remove(obj)
+    bones_alone, joints_alone = bones_of_the_biped_alone()
     body, sword_start = add_body_holding_a_joined_sword()
     select_only([body], active=body)
 
@@ -313,22 +339,8 @@ def test_the_rig_command_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand
     leaves both out of the skeleton (the bones of the biped alone) and binds
     each wholly to its hand. Before, both were skinned with the body, as part
     of it."""
-    character = generate_character(BIPED_SEED, "biped")
-    alone = add_biped("Alone")
-    select_only([alone], active=alone)
-    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
-    (skeleton_alone,) = armatures()
-    bones_alone = [bone.name for bone in skeleton_alone.data.bones]
-    for obj in (skeleton_alone, alone):
-        bpy.data.objects.remove(obj)
-    body, sword = add_biped(), add_sword()
-    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
-    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
-    bpy.context.view_layer.update()
-    old_rig = build_armature(character.skeleton, "Rig", bpy.context)
-    bind(body, old_rig)
-    parent_to_bone(sword, old_rig, "hand.R")
-    parent_to_bone(offhand, old_rig, "hand.L")
+    bones_alone = bones_of_the_biped_alone()[0]
+    add_body_with_a_sword_in_each_hand_on_a_rig()
     source, out = tmp_path / "two_swords.blend", tmp_path / "out"
     scene_io.save_scene(source)
     capsys.readouterr()
@@ -345,9 +357,7 @@ def test_the_rig_command_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand
     armature = bpy.data.objects[item["armature"]]
     assert [bone.name for bone in armature.data.bones] == bones_alone
     assert_bound_wholly_to(bpy.data.objects["Sword"], armature, "hand.R")
-    skeleton = convert.read_skeleton(armature)
-    weights = group_weights(bpy.data.objects["Sword_Offhand"], skeleton.names)
-    assert np.array_equal(weights[:, skeleton.names.index("hand.L")], np.ones(len(weights)))
+    assert_wholly_on(bpy.data.objects["Sword_Offhand"], armature, "hand.L")
 
 
 def test_auto_rig_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_as_props(clean_scene, capfd):
@@ -356,15 +366,7 @@ def test_auto_rig_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_
     Binding*: the rig being replaced says what it carried, so both swords
     are held props bound wholly to the new hands; the old rig goes (nothing
     follows it any more)."""
-    character = generate_character(BIPED_SEED, "biped")
-    body, sword = add_biped(), add_sword()
-    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
-    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
-    bpy.context.view_layer.update()
-    old_rig = build_armature(character.skeleton, "Rig", bpy.context)
-    bind(body, old_rig)
-    parent_to_bone(sword, old_rig, "hand.R")
-    parent_to_bone(offhand, old_rig, "hand.L")
+    body, sword, offhand = add_body_with_a_sword_in_each_hand_on_a_rig()
     select_only([body, sword, offhand], active=body)
 
     assert bpy.ops.autorig.auto_rig(rig_replace=True) == {"FINISHED"}
@@ -375,6 +377,4 @@ def test_auto_rig_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_
     for name, bone in (("Sword", "hand.R"), ("Sword_Offhand", "hand.L")):
         assert f"'{name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
     assert_bound_wholly_to(sword, armature, "hand.R")
-    skeleton = convert.read_skeleton(armature)
-    weights = group_weights(offhand, skeleton.names)
-    assert np.array_equal(weights[:, skeleton.names.index("hand.L")], np.ones(len(weights)))
+    assert_wholly_on(offhand, armature, "hand.L")
