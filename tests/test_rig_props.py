@@ -153,6 +153,18 @@ def test_predict_skeleton_leaves_a_held_sword_out_and_untouched(clean_scene, cap
     assert "'Sword' is held: a rigid prop, left out of the skeleton" in capfd.readouterr().out
 
 
+def rig_saved_scene(tmp_path, capsys, name: str, option: str) -> dict:
+    """Save the scene as ``name``.blend, run ``rig`` on it with ``option`` into
+    ``tmp_path/out``, check it exits 0, and return its one summary item."""
+    source = tmp_path / f"{name}.blend"
+    scene_io.save_scene(source)
+    capsys.readouterr()
+    code = main(["rig", str(source), "--out", str(tmp_path / "out"), option, "--quiet"])
+    assert code == 0
+    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    return item
+
+
 def bones_of_the_biped_alone() -> tuple[list, np.ndarray]:
     """The bone names and joints Predict Skeleton gives the biped with nothing else in the scene (removed after)."""
     alone = add_biped("Alone")
@@ -281,18 +293,11 @@ def test_the_rig_command_with_rigify_binds_the_sword_to_the_def_hand(clean_scene
     """Every mesh of the file is taken; the sword goes to the generated
     rig's deform bone of the hand."""
     add_biped(), add_sword()
-    source, out = tmp_path / "knight.blend", tmp_path / "out"
-    scene_io.save_scene(source)
-    capsys.readouterr()
-
-    code = main(["rig", str(source), "--out", str(out), "--rigify", "--quiet"])
-
-    assert code == 0
-    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    item = rig_saved_scene(tmp_path, capsys, "knight", "--rigify")
     assert item["meshes"] == ["Biped"] and item["rigify"]
     assert "'Sword' held: bound wholly to bone 'DEF-hand.R' (a rigid prop, left out of the skeleton)" \
         in item["notes"]
-    scene_io.load_scene(out / "knight.blend")
+    scene_io.load_scene(tmp_path / "out" / "knight.blend")
     armature, sword = bpy.data.objects[item["armature"]], bpy.data.objects["Sword"]
     assert_no_bone_near_the_blade(armature, sword)
     assert_bound_wholly_to(sword, armature, "DEF-hand.R", turn_fk_hand)
@@ -313,17 +318,10 @@ def test_the_rig_command_replacing_a_posed_rig_takes_the_sword_from_its_bone_whe
     parent_to_bone(sword, old_rig, "hand.R")
     pose_bone_turned(old_rig, "upper_arm.R", 60.0)
     assert np.abs(evaluated_world_vertices(sword) - box_mesh(SWORD_LOW, SWORD_HIGH, 0.02).vertices).max() > 0.2
-    source, out = tmp_path / "posed.blend", tmp_path / "out"
-    scene_io.save_scene(source)
-    capsys.readouterr()
-
-    code = main(["rig", str(source), "--out", str(out), "--replace", "--quiet"])
-
-    assert code == 0
-    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    item = rig_saved_scene(tmp_path, capsys, "posed", "--replace")
     assert item["meshes"] == ["Biped"] and item["replaced"] == ["Rig"]
     assert "'Sword' held: bound wholly to bone 'hand.R' (a rigid prop, left out of the skeleton)" in item["notes"]
-    scene_io.load_scene(out / "posed.blend")
+    scene_io.load_scene(tmp_path / "out" / "posed.blend")
     armature, sword = bpy.data.objects[item["armature"]], bpy.data.objects["Sword"]
     np.testing.assert_allclose(evaluated_world_vertices(sword), box_mesh(SWORD_LOW, SWORD_HIGH, 0.02).vertices,
                                atol=1e-5)
@@ -341,19 +339,12 @@ def test_the_rig_command_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand
     of it."""
     bones_alone = bones_of_the_biped_alone()[0]
     add_body_with_a_sword_in_each_hand_on_a_rig()
-    source, out = tmp_path / "two_swords.blend", tmp_path / "out"
-    scene_io.save_scene(source)
-    capsys.readouterr()
-
-    code = main(["rig", str(source), "--out", str(out), "--replace", "--quiet"])
-
-    assert code == 0
-    (item,) = json.loads(capsys.readouterr().out)["succeeded"]
+    item = rig_saved_scene(tmp_path, capsys, "two_swords", "--replace")
     assert item["meshes"] == ["Biped"] and item["template"] == "biped"
     for name, bone in (("Sword", "hand.R"), ("Sword_Offhand", "hand.L")):
         assert f"'{name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" \
             in item["notes"]
-    scene_io.load_scene(out / "two_swords.blend")
+    scene_io.load_scene(tmp_path / "out" / "two_swords.blend")
     armature = bpy.data.objects[item["armature"]]
     assert [bone.name for bone in armature.data.bones] == bones_alone
     assert_bound_wholly_to(bpy.data.objects["Sword"], armature, "hand.R")
