@@ -13,6 +13,7 @@ from autorig_addon.core.nn.weights_io import load_weights
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT
+from autorig_addon.core.skeleton.key_joints import KEY_JOINT_TWINS
 from autorig_addon.training.rigging.proportions import proportion_variant, reproportioned, source_character
 from autorig_addon.training.rigging.training_set import reference_skeleton, sample_examples
 from geometry_fixtures import procedural_sample
@@ -21,7 +22,6 @@ torch = pytest.importorskip("torch")
 pytestmark = pytest.mark.torch
 
 from autorig_addon.training.rigging.landmarks import (  # noqa: E402
-    MIRRORED,
     UNTAUGHT_KIND,
     holdout_scores,
     landmark_data,
@@ -136,8 +136,8 @@ def test_landmark_targets_follow_a_stretched_variant_and_mirroring_swaps_sides()
     shift = variant.joints.min(axis=0) - scale * source.min(axis=0)
     np.testing.assert_allclose(moved[known > 0], (scale * targets + shift)[known > 0], atol=1e-5)
     # Mirroring swaps each left landmark with its right twin and keeps the midline ones.
-    assert [LANDMARKS[index] for index in MIRRORED[:4]] == ["hips", "neck", "head", "shoulder.R"]
-    assert sorted(MIRRORED.tolist()) == list(range(len(LANDMARKS)))
+    assert [LANDMARKS[index] for index in KEY_JOINT_TWINS[:4]] == ["hips", "neck", "head", "shoulder.R"]
+    assert sorted(KEY_JOINT_TWINS) == list(range(len(LANDMARKS)))
 
 
 def test_the_upright_network_learns_which_way_is_up_and_its_run_reproduces():

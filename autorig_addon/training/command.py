@@ -5,7 +5,8 @@ Registered by :mod:`autorig_addon.cli.main` when this package is present
 
 ``train samples`` builds the cached samples of the characters (needs the
 ``bpy`` module); ``train skin --model NAME`` and ``train rig --model NAME``
-train one network from those samples alone (torch, no Blender: it also
+train one network from those samples alone, and ``train library`` writes
+the rig library of their key joints (:mod:`.rigging.library`) (torch, no Blender: it also
 runs on a machine without bpy) and write its weights where the extension
 reads them. Fixed seed, so the
 same command gives the same weights on the same device; see
@@ -36,9 +37,10 @@ DEVICES = ("auto", "cpu", "cuda")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("what", choices=("skin", "rig", "samples"),
-                        help="skin: train one skinning network; rig: train one skeleton network; samples: build the "
-                             "cached samples (needs bpy)")
+    parser.add_argument("what", choices=("skin", "rig", "library", "samples"),
+                        help="skin: train one skinning network; rig: train one skeleton network; library: write the "
+                             "rig library of the training characters' key joints; samples: build the cached "
+                             "samples (needs bpy)")
     parser.add_argument("--model", choices=NETWORK_NAMES + RIG_NETWORK_NAMES,
                         help=f"The network to train: train skin {'|'.join(NETWORK_NAMES)}; "
                              f"train rig {'|'.join(RIG_NETWORK_NAMES)}")
@@ -77,6 +79,14 @@ def run(args: argparse.Namespace) -> int:
     samples = args.samples or default_cache_dir()
     if args.what == "samples":
         return EXIT_FAILED if _build_samples(args.characters, samples) else EXIT_OK
+    if args.what == "library":
+        from .rigging.library import write_rig_library
+
+        library = write_rig_library(samples, args.output)
+        print(f"rig library: {len(library.names)} training characters ("
+              f"{int((library.kinds == 'biped').sum())} bipeds, {int((library.kinds == 'quadruped').sum())} "
+              "quadrupeds)", file=sys.stderr)
+        return EXIT_OK
     names = NETWORK_NAMES if args.what == "skin" else RIG_NETWORK_NAMES
     if args.model not in names:
         raise UsageError(f"train {args.what} needs --model " + "|".join(names) + ".")

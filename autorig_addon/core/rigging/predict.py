@@ -48,6 +48,7 @@ from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .orientation import stand_upright
 from .quality import skeleton_problems
+from .rig_library import closest_rig
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
@@ -240,13 +241,16 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                      "from behind and turned back.")
     landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
+    normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
+    landmarks, library_notes = _closest_rig_key_joints(normalised_surface, landmarks)
+    notes += library_notes
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
-                   surface=Mesh(apply_transform(surface.vertices, transform), surface.triangles))
+                   surface=normalised_surface)
 
 
 def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> tuple[Landmarks, tuple]:
@@ -266,6 +270,19 @@ def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landm
     note = (f"The legs are short (crotch at {height_map.crotch / top:.0%} of the height) and were first read as "
             f"longer: the landmarks were read again on the body stretched to a crotch at {TYPICAL_CROTCH_SHARE:.0%}.")
     return replace(reread, points=points_back(reread.points, stretch, height_map)), (note,)
+
+
+def _closest_rig_key_joints(normalised: Mesh, landmarks: Landmarks) -> tuple[Landmarks, tuple]:
+    """The landmarks of a body read surely as a biped or a quadruped with the
+    key joints of the closest known rig of that kind put in their place when
+    one lies near enough (:mod:`.rig_library`; ``normalised``: the full
+    surface in the normalised frame), and the note saying so; else as they are."""
+    if landmarks.kind not in STANDARD_KINDS or landmarks.confidence < KIND_CONFIDENCE:
+        return landmarks, ()
+    match = closest_rig(normalised, landmarks.kind)
+    if match is None:
+        return landmarks, ()
+    return replace(landmarks, points={**landmarks.points, **match.points}, copied_from=match.name), (match.note,)
 
 
 def framed_transform(vertices: np.ndarray, rotation: np.ndarray) -> np.ndarray:

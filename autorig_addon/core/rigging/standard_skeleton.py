@@ -86,10 +86,13 @@ class Landmarks:
     ----------
     points : dict mapping each name of :data:`LANDMARKS` to its (3,) position
     kind_probabilities : dict mapping each kind of :data:`BODY_KINDS` to its probability
+    copied_from : str, the known rig whose key joints replaced the network's
+        (:mod:`.rig_library`); None when they are the network's own
     """
 
     points: dict
     kind_probabilities: dict
+    copied_from: str | None = None
 
     @property
     def kind(self) -> str:
@@ -493,12 +496,14 @@ def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, sym
     ``surface`` (the full-resolution mesh, normalised) is given and both
     hands have separable ones (:func:`both_hands_fingers`)."""
     points = symmetrised(landmarks.points, symmetric_shape)
-    if kind == BIPED:
+    if kind == BIPED and landmarks.copied_from is None:
+        # These correct where the network puts a biped's joints; an artist's rig copied whole is left as it is.
         points = head_near_neck(hips_at_most_at_hip_joints(points))
         # Each arm is read on its own side; a symmetric shape's shoulders and wrists stay mirror images.
         arms_from = vertices if surface is None else surface.vertices
         points = symmetrised(wrists_past_narrowest_forearm(shoulders_on_arm_axes(points, vertices), arms_from),
                              symmetric_shape)
+    if kind == BIPED:
         fingers = both_hands_fingers(points, surface, symmetric_shape) if surface is not None else None
         return biped_skeleton(points, vertices, fingers)
     if kind == QUADRUPED:

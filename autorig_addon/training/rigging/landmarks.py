@@ -33,8 +33,8 @@ from ...core.nn.numpy_kernels import NUMPY
 from ...core.nn.spec import shipped_weights
 from ...core.rigging.joint_features import VERTEX_VECTORS
 from ...core.rigging.networks import rig_network
-from ...core.rigging.networks.landmarks import BODY_KINDS, LANDMARKS
-from ...core.skeleton.key_joints import LEFT, RIGHT, key_joints
+from ...core.rigging.networks.landmarks import sample_landmarks
+from ...core.skeleton.key_joints import KEY_JOINT_TWINS
 from ..nn.augmentation import turn_and_mirror, turned_columns
 from ..nn.fit import FitRecord, fit
 from ..nn.modules import NetworkModule, as_tensors
@@ -49,25 +49,8 @@ KIND_LOSS_WEIGHT = 0.05
 #: standing monsters read as "other"), so the variants teach where the landmarks lie and the kind is learnt from the
 #: characters' own shapes, as before.
 UNTAUGHT_KIND = -1
-#: The split's kinds of character (and the procedural generator's) and the body kind each teaches.
-CATEGORY_KINDS = {"humanoid": "biped", "quadruped": "quadruped", "biped": "biped"}
-#: Each landmark's mirror twin (itself on the midline), as indices.
-MIRRORED = np.array([LANDMARKS.index(name.replace(LEFT, "#").replace(RIGHT, LEFT).replace("#", RIGHT))
-                     for name in LANDMARKS])
 #: Trunk parameters taken from the joint network before training.
 TRUNK_PREFIXES = ("encoder.", "gmedge", "shape.")
-
-
-def sample_landmarks(sample: CharacterSample) -> tuple[np.ndarray, np.ndarray, int]:
-    """(k, 3) landmark targets (normalised frame), (k,) which are known, and the body kind's index."""
-    found = key_joints(sample.names, sample.joints, left_direction=np.array([1.0, 0.0, 0.0]),
-                       parents=sample.parents).positions
-    targets = np.zeros((len(LANDMARKS), 3), dtype=np.float32)
-    known = np.zeros(len(LANDMARKS), dtype=np.float32)
-    for index, name in enumerate(LANDMARKS):
-        if name in found:
-            targets[index], known[index] = found[name], 1.0
-    return targets, known, BODY_KINDS.index(CATEGORY_KINDS.get(sample.category, "other"))
 
 
 def variant_landmarks(sample: CharacterSample, example: RigExample, targets: np.ndarray) -> np.ndarray:
@@ -102,7 +85,7 @@ def landmark_loss(module: NetworkModule, item: tuple, matrix: np.ndarray) -> tor
     graph, targets, known, kind = item
     turn = torch.as_tensor(matrix, dtype=torch.float32, device=targets.device)
     if np.linalg.det(matrix) < 0:
-        order = torch.as_tensor(MIRRORED, device=targets.device)
+        order = torch.as_tensor(KEY_JOINT_TWINS, device=targets.device)
         targets, known = targets[order], known[order]
     turned = replace(graph, vertex_features=turned_columns(TORCH, graph.vertex_features, VERTEX_VECTORS, turn))
     landmarks, logits = module(turned)

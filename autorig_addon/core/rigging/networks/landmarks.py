@@ -13,11 +13,14 @@ quadruped or other (:data:`BODY_KINDS`).
 
 from __future__ import annotations
 
+import numpy as np
+
+from ...dataset.sample import CharacterSample
 from ...nn.convolution import gmedge_trunk
 from ...nn.layers import mlp
 from ...nn.operations import Array, Operations
 from ...nn.spec import Dense, NetworkSpec, TrainingSettings
-from ...skeleton.key_joints import KEY_JOINTS
+from ...skeleton.key_joints import KEY_JOINTS, key_joints
 from ..joint_features import JointGraph
 from .joints import TRUNK, WIDTH
 from .trained import TRAINED_FOLDER
@@ -26,6 +29,8 @@ from .trained import TRAINED_FOLDER
 LANDMARKS = KEY_JOINTS
 #: Kinds of body the network tells apart, in output order.
 BODY_KINDS = ("biped", "quadruped", "other")
+#: The split's kinds of character (and the procedural generator's) and the body kind each teaches.
+CATEGORY_KINDS = {"humanoid": "biped", "quadruped": "quadruped", "biped": "biped"}
 
 
 def landmark_network(ops: Operations, params: dict, graph: JointGraph) -> tuple[Array, Array]:
@@ -48,6 +53,18 @@ def landmark_network(ops: Operations, params: dict, graph: JointGraph) -> tuple[
     kind_logits = mlp(ops, params, joined[:1, -TRUNK.shape_width:], "kind.", activation=SPEC.activation,
                       activate_last=False)
     return landmarks, kind_logits
+
+
+def sample_landmarks(sample: CharacterSample) -> tuple[np.ndarray, np.ndarray, int]:
+    """(k, 3) landmark targets (normalised frame), (k,) which are known, and the body kind's index."""
+    found = key_joints(sample.names, sample.joints, left_direction=np.array([1.0, 0.0, 0.0]),
+                       parents=sample.parents).positions
+    targets = np.zeros((len(LANDMARKS), 3), dtype=np.float32)
+    known = np.zeros(len(LANDMARKS), dtype=np.float32)
+    for index, name in enumerate(LANDMARKS):
+        if name in found:
+            targets[index], known[index] = found[name], 1.0
+    return targets, known, BODY_KINDS.index(CATEGORY_KINDS.get(sample.category, "other"))
 
 
 SPEC = NetworkSpec(

@@ -1,0 +1,218 @@
+"""Key joints of the closest known rig: a library of the training characters' key joints.
+
+The landmark network places key joints the way the bodies it learnt from
+have them; a close relative of a training character (the validation cow
+of Quaternius' animal pack beside its training bull, the asian elephants of
+0 A.D. in other harness) is rigged better by the relative's artist than by
+the network's average: on the held-out training characters the copied key
+joints are more often right (within 0.05) than the network's
+(:data:`LIBRARY_DISTANCE`), above all on animals, whose artists place the
+wrists at the hoof or at the carpus and the hips at the pelvis or at the
+tail's root, family by family.
+
+The library (``trained/rig_library.npz``, built by ``train library``)
+holds, per training biped and quadruped whose bone names give key joints,
+:data:`SURFACE_POINTS` points on its normalised surface and its key joints
+in that frame. A character read as one of those kinds takes the key joints
+of the entry of its kind whose surface is nearest (symmetric Chamfer
+distance, in units of the largest side) when that distance is at most
+:data:`LIBRARY_DISTANCE`, mapped by the per-axis affine map between the two
+bounding boxes; the landmark network's stay for the key joints the entry
+lacks (KayKit's rigs have no neck).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..skeleton.key_joints import KEY_JOINT_TWINS, KEY_JOINTS
+from ..types import Mesh
+from .nearest_character import SURFACE_POINTS, box_map, surface_points
+from .networks.landmarks import BODY_KINDS, sample_landmarks
+from .networks.trained import TRAINED_FOLDER
+
+#: The shipped library.
+LIBRARY_FILE = TRAINED_FOLDER / "rig_library.npz"
+#: Nearest surfaces at most this far apart (symmetric Chamfer distance of
+#: :data:`SURFACE_POINTS` points each, share of the largest side) give their
+#: key joints. Chosen without the validation characters (2026-11-26):
+#:
+#: - on the 40 held-out training bipeds and quadrupeds (every sixth by name,
+#:   which the landmark network never trained on), each with itself and its
+#:   near-duplicates out of the library (``scripts/tune_rig_library.py``),
+#:   key joints within 0.05 are 85.9 % (the network's alone), 87.6 % with a
+#:   limit of 0.015, 86.3 % at 0.02, 87.3 % at 0.025, 87.7 % at 0.03, 86.2 %
+#:   at 0.035: flat from 0.015 to 0.03, one character apart;
+#: - over every training character so copied, the copy's key joints are
+#:   right for 92 % of those 0.01 to 0.015 away, 81 % at 0.015 to 0.02, 71 %
+#:   at 0.02 to 0.025, but 52 % at 0.025 to 0.03 and 23 % beyond: there a
+#:   body is like a generic one of its kind, no relative;
+#: - on procedural bipeds and quadrupeds (seeds 0 to 9, exact roles), which
+#:   no artist rigged, copies 0.025 to 0.03 away placed fewer key joints
+#:   than the network on four of five.
+#:
+#: The surfaces of two near-duplicates lie 0.007 to 0.01 apart.
+LIBRARY_DISTANCE = 0.025
+#: Points of each entry measured first (:func:`closest_rig`): a uniform
+#: sample of the stored ones, which were drawn at random. Their mean
+#: distance estimates the entry's within about 6 % (one standard deviation).
+SCREEN_POINTS = 250
+#: An entry is measured in full while half its screened distance is at most
+#: this many times the best distance so far: four standard deviations of
+#: the estimate.
+SCREEN_MARGIN = 1.25
+#: Entries measured in full at most, the nearest one way first. On every
+#: cached training and validation character read as either kind (832
+#: readings), the same entry as measuring all of them at the shipped limit
+#: (``scripts/tune_rig_library.py --check-screen``); at a limit of 0.04, 7
+#: differ, each with its nearest entry beyond 0.03.
+MEASURED_IN_FULL = 16
+
+
+@dataclass(frozen=True)
+class RigLibrary:
+    """The training characters' key joints, each with its surface.
+
+    Attributes
+    ----------
+    names : (n,) str, the characters (paths in the data without extension)
+    kinds : (n,) str, ``biped`` or ``quadruped``
+    points : (n, SURFACE_POINTS, 3) float32, points on each normalised surface
+    key_joints : (n, k, 3) float32, in :data:`...skeleton.key_joints.KEY_JOINTS` order
+    known : (n, k) bool, which key joints each rig has
+    boxes : (n, 2, 3) float32, each normalised mesh's bounding box (lowest, highest corner)
+    """
+
+    names: np.ndarray
+    kinds: np.ndarray
+    points: np.ndarray
+    key_joints: np.ndarray
+    known: np.ndarray
+    boxes: np.ndarray
+
+    def save(self, path: Path) -> None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # Half precision: 0.0005 of the largest side at worst, far below the distances compared.
+        np.savez_compressed(path, names=self.names, kinds=self.kinds, points=self.points.astype(np.float16),
+                            key_joints=self.key_joints.astype(np.float32), known=self.known,
+                            boxes=self.boxes.astype(np.float32))
+
+    @classmethod
+    def load(cls, path: Path) -> "RigLibrary":
+        with np.load(path, allow_pickle=False) as data:
+            return cls(data["names"], data["kinds"], data["points"].astype(np.float32), data["key_joints"],
+                       data["known"], data["boxes"])
+
+
+@dataclass(frozen=True)
+class ClosestRig:
+    """The library entry nearest a character: its name, the surface distance,
+    and its key joints mapped onto the character (normalised frame), the
+    ones its rig has only."""
+
+    name: str
+    distance: float
+    points: dict
+
+    @property
+    def note(self) -> str:
+        return (f"Key joints copied from the closest known rig, {self.name} (surfaces {self.distance:.3f} of the "
+                f"largest side apart); the landmark network's kept for the {len(KEY_JOINTS) - len(self.points)} "
+                "it lacks." if len(self.points) < len(KEY_JOINTS) else
+                f"Key joints copied from the closest known rig, {self.name} (surfaces {self.distance:.3f} of the "
+                "largest side apart).")
+
+
+@lru_cache(maxsize=1)
+def shipped_library() -> RigLibrary | None:
+    """The shipped library, read once; None when the file is absent (a checkout before ``train library``)."""
+    return RigLibrary.load(LIBRARY_FILE) if LIBRARY_FILE.is_file() else None
+
+
+def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
+                limit: float = LIBRARY_DISTANCE) -> ClosestRig | None:
+    """The entry of ``kind`` whose surface is nearest ``surface`` (normalised
+    frame) when at most ``limit`` away, else None.
+
+    Measuring every entry in full would take about a second (160 bipeds).
+    Each entry is first measured one way on :data:`SCREEN_POINTS` of its
+    points; then, in that order, at most :data:`MEASURED_IN_FULL` are
+    measured in full, and none whose screened half-distance exceeds
+    :data:`SCREEN_MARGIN` times the best so far or the limit (an entry's
+    Chamfer distance is at least half its one-way distance).
+    """
+    library = shipped_library() if library is None else library
+    if library is None:
+        return None
+    entries = np.flatnonzero(library.kinds == kind)
+    if not len(entries):
+        return None
+    target = surface_points(surface.vertices, surface.triangles, SURFACE_POINTS)
+    target_tree = cKDTree(target)
+    screened = target_tree.query(library.points[entries, :SCREEN_POINTS].reshape(-1, 3))[0]
+    estimates = screened.reshape(len(entries), -1).mean(axis=1)
+    best, best_distance = None, np.inf
+    for order in np.argsort(estimates, kind="stable")[:MEASURED_IN_FULL]:
+        if 0.5 * estimates[order] > SCREEN_MARGIN * min(best_distance, limit):
+            break
+        points = library.points[entries[order]]
+        distance = 0.5 * (target_tree.query(points)[0].mean() + cKDTree(points).query(target)[0].mean())
+        if distance < best_distance:
+            best, best_distance = entries[order], float(distance)
+    if best is None or best_distance > limit:
+        return None
+    low, high = library.boxes[best].astype(np.float64)
+    mapped = box_map(library.key_joints[best].astype(np.float64), np.array([low, high]),
+                     np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
+    points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
+    return ClosestRig(str(library.names[best]), best_distance, points)
+
+
+#: The kinds the library holds: those with a standard skeleton.
+LIBRARY_KINDS = ("biped", "quadruped")
+#: Largest distance (share of the largest side) from a left key joint's
+#: mirror image to its right twin in an entry: the key-joint tolerance.
+MAX_TWIN_MIRROR_ERROR = 0.05
+
+
+def twin_mirror_error(key_joints: np.ndarray, known: np.ndarray) -> float:
+    """The largest distance from a known key joint's mirror image (across
+    x = 0) to its known twin; 0 when no pair is known."""
+    twins = np.array(KEY_JOINT_TWINS)
+    both = known & known[twins]
+    if not both.any():
+        return 0.0
+    mirrored = key_joints * np.array([-1.0, 1.0, 1.0])
+    return float(np.linalg.norm(mirrored[both] - key_joints[twins][both], axis=1).max())
+
+
+def build_rig_library(samples: list) -> RigLibrary:
+    """The library of ``samples`` (normalised CharacterSamples), by name:
+    those of a kind of :data:`LIBRARY_KINDS` (the split's category,
+    :data:`.networks.landmarks.CATEGORY_KINDS`) whose bone names give a key
+    joint (:func:`.networks.landmarks.sample_landmarks`, the landmark
+    network's own targets) and whose twin key joints are mirror images
+    (:data:`MAX_TWIN_MIRROR_ERROR`): Nexuiz's and some SuperTuxKart
+    characters rest in a pose, and one 0 A.D. elephant's left legs are
+    rigged elsewhere than its body's, while a standard skeleton is built
+    symmetric."""
+    names, kinds, points, key_joints, known, boxes = [], [], [], [], [], []
+    for sample in sorted(samples, key=lambda sample: sample.name):
+        targets, has, kind = sample_landmarks(sample)
+        if (BODY_KINDS[kind] not in LIBRARY_KINDS or not has.any()
+                or twin_mirror_error(targets, has > 0) > MAX_TWIN_MIRROR_ERROR):
+            continue
+        names.append(sample.name)
+        kinds.append(BODY_KINDS[kind])
+        points.append(surface_points(sample.vertices, sample.triangles, SURFACE_POINTS))
+        key_joints.append(targets)
+        known.append(has > 0)
+        boxes.append([sample.vertices.min(axis=0), sample.vertices.max(axis=0)])
+    return RigLibrary(np.array(names), np.array(kinds), np.array(points, dtype=np.float32),
+                      np.array(key_joints, dtype=np.float32), np.array(known, dtype=bool),
+                      np.array(boxes, dtype=np.float32))

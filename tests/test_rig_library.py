@@ -1,0 +1,133 @@
+"""The rig library (core/rigging/rig_library.py): a character read as a biped
+or a quadruped takes the key joints of the nearest known rig of its kind
+when that rig's surface lies near enough, mapped onto its bounding box."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.dataset.sample import CharacterSample
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict, rig_library
+from autorig_addon.core.rigging.nearest_character import SURFACE_POINTS
+from autorig_addon.core.rigging.networks.landmarks import sample_landmarks
+from autorig_addon.core.rigging.rig_library import RigLibrary, build_rig_library, closest_rig, twin_mirror_error
+from autorig_addon.core.skeleton.key_joints import KEY_JOINTS, key_joints
+from autorig_addon.core.types import Mesh
+
+
+def procedural(kind: str, seed: int = 0):
+    """(normalised sample, generated character) of a procedural ``kind``."""
+    character = generate_character(seed, kind)
+    sample = CharacterSample.from_character(f"procedural/{kind}_{seed}", character.kind, character.mesh,
+                                            character.skeleton, character.weights)
+    return sample, character
+
+
+@pytest.fixture(scope="module")
+def biped():
+    return procedural("biped")
+
+
+@pytest.fixture(scope="module")
+def library(biped):
+    """A biped, a quadruped and a fish: the fish, no biped or quadruped, stays out."""
+    return build_rig_library([biped[0], procedural("quadruped")[0], procedural("fish")[0]])
+
+
+def normalised_copy(sample: CharacterSample, factors) -> Mesh:
+    return Mesh(sample.vertices * np.asarray(factors, dtype=np.float64), sample.triangles)
+
+
+def test_the_library_holds_the_bipeds_and_quadrupeds_with_key_joints(library, biped):
+    assert library.names.tolist() == ["procedural/biped_0", "procedural/quadruped_0"]
+    assert library.kinds.tolist() == ["biped", "quadruped"]
+    assert library.points.shape == (2, SURFACE_POINTS, 3)
+    # Every key joint of the biped; the quadruped's generator names no neck and no head joint it plays.
+    assert library.known.sum(axis=1).tolist() == [15, 13]
+    targets, _, _ = sample_landmarks(biped[0])
+    np.testing.assert_allclose(library.key_joints[0], targets, atol=1e-6)
+
+
+def test_a_rig_whose_twin_joints_are_no_mirror_images_is_left_out(biped):
+    sample = biped[0]
+    wrist = key_joints(sample.names, sample.joints).bones["wrist.L"]
+    joints = sample.joints.copy()
+    joints[wrist, 2] += 0.08  # the left hand raised: a pose, or a rig off its body
+    posed = replace(sample, joints=joints)
+    targets, known, _ = sample_landmarks(posed)
+    assert twin_mirror_error(targets, known > 0) == pytest.approx(0.08, abs=1e-6)
+    assert build_rig_library([posed]).names.tolist() == []
+
+
+def test_twin_mirror_error_by_hand():
+    joints = np.zeros((len(KEY_JOINTS), 3))
+    known = np.zeros(len(KEY_JOINTS), dtype=bool)
+    left, right = KEY_JOINTS.index("knee.L"), KEY_JOINTS.index("knee.R")
+    joints[left], joints[right] = [0.1, 0.0, 0.3], [-0.1, 0.03, 0.34]
+    assert twin_mirror_error(joints, known) == 0.0  # no pair known
+    known[[left, right]] = True
+    assert twin_mirror_error(joints, known) == pytest.approx(0.05)
+
+
+def test_a_stretched_relative_takes_the_key_joints_stretched_by_the_same_factors(library, biped, tmp_path):
+    factors = np.array([1.0, 1.1, 0.95])
+    match = closest_rig(normalised_copy(biped[0], factors), "biped", library)
+    assert match.name == "procedural/biped_0"
+    assert 0.005 < match.distance < 0.02  # measured 0.0148: near, but not the same surface
+    targets, _, _ = sample_landmarks(biped[0])
+    assert set(match.points) == set(KEY_JOINTS)
+    for index, name in enumerate(KEY_JOINTS):
+        np.testing.assert_allclose(match.points[name], targets[index] * factors, atol=1e-5)
+    # Saved at half precision and read back, the same entry and key joints.
+    library.save(tmp_path / "library.npz")
+    again = closest_rig(normalised_copy(biped[0], factors), "biped", RigLibrary.load(tmp_path / "library.npz"))
+    assert again.name == match.name and abs(again.distance - match.distance) < 1e-3
+    np.testing.assert_allclose(again.points["knee.L"], match.points["knee.L"], atol=1e-6)
+
+
+def test_only_a_rig_of_the_kind_read_and_near_enough_is_copied(library, biped):
+    copy = normalised_copy(biped[0], [1.0, 1.1, 0.95])
+    distance = closest_rig(copy, "biped", library).distance
+    assert closest_rig(copy, "biped", library, limit=0.5 * distance) is None
+    assert closest_rig(copy, "biped", library, limit=2.0 * distance).name == "procedural/biped_0"
+    only_quadruped = RigLibrary(*(array[1:] for array in (library.names, library.kinds, library.points,
+                                                             library.key_joints, library.known, library.boxes)))
+    assert closest_rig(copy, "biped", only_quadruped) is None
+    # A generic body of another shape is no relative at the shipped limit.
+    other_biped = procedural("biped", seed=3)[0]
+    assert closest_rig(Mesh(other_biped.vertices, other_biped.triangles), "biped", library) is None
+
+
+def test_a_rig_without_a_neck_gives_the_key_joints_it_has_and_says_so(library, biped):
+    known = library.known.copy()
+    known[0, KEY_JOINTS.index("neck")] = False  # as KayKit's rigs: no neck bone
+    neckless = replace(library, known=known)
+    match = closest_rig(normalised_copy(biped[0], [1.0, 1.0, 1.0]), "biped", neckless)
+    assert "neck" not in match.points and len(match.points) == 14
+    assert match.note.endswith("the landmark network's kept for the 1 it lacks.")
+
+
+def key_joint_errors(skeleton, reference, size):
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    truth = key_joints(reference.names, reference.joints, left_direction=[1.0, 0.0, 0.0],
+                       parents=reference.parents).positions
+    return {role: float(np.linalg.norm(found[role] - truth[role])) / size for role in truth}
+
+
+def test_a_character_whose_relative_is_known_gets_its_artist_key_joints(library, biped, monkeypatch):
+    character = biped[1]
+    size = float(np.ptp(character.mesh.vertices, axis=0).max())
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: None)
+    alone = predict.predict_votes(character.mesh)
+    assert alone.landmarks.copied_from is None
+    network_errors = key_joint_errors(predict.skeleton_from_votes(alone, template="biped"), character.skeleton, size)
+    assert max(network_errors.values()) > 0.05  # measured: the head 0.062, the neck 0.059 off
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    votes = predict.predict_votes(character.mesh)
+    assert votes.landmarks.copied_from == "procedural/biped_0"
+    assert ("Key joints copied from the closest known rig, procedural/biped_0 (surfaces 0.000 of the largest side "
+            "apart).") in votes.notes
+    copied_errors = key_joint_errors(predict.skeleton_from_votes(votes, template="biped"), character.skeleton, size)
+    assert max(copied_errors.values()) < 1e-6
