@@ -9,8 +9,10 @@ import pytest
 from autorig_addon.blender import scene_io
 from autorig_addon.blender.convert import read_weights
 from autorig_addon.cli.main import main
+from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging import predict
+from autorig_addon.core.rigging import predict, rig_library
+from autorig_addon.core.skeleton.key_joints import key_joints
 from blender_fixtures import make_armature, mesh_object, reset_scene
 
 #: A symmetric procedural biped (1,866 vertices).
@@ -142,6 +144,7 @@ def test_a_standard_biped_with_mixamo_names_then_renamed_to_unreal(clean_scene, 
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["rigify"], item["bones"]) == ("biped", False, 22)
     assert item["body"] in ("biped", "quadruped", "other") and 0.0 <= item["confidence"] <= 1.0
+    assert item["key_joints_from"] is None  # no training character lies within 0.025 of this procedural biped
     armature, mesh = the_armature_and_mesh(out)
     assert {"mixamorig:Hips", "mixamorig:LeftArm", "mixamorig:RightToeBase"} <= set(armature.data.bones.keys())
     assert "mixamorig:LeftUpLeg" in mesh.vertex_groups
@@ -265,3 +268,26 @@ def test_rigid_parts_bind_each_piece_mostly_on_one_bone_wholly_to_it_unless_swit
     assert count >= 1
     np.testing.assert_allclose(results["--rigid-parts"][1], expected, atol=1e-6)
     assert not np.allclose(smooth, expected, atol=1e-3)
+
+
+def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scene, tmp_path, capsys, monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+    character = generate_character(BIPED_SEED, "biped")
+    sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
+                                            character.weights)
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["key_joints_from"]) == ("biped", "procedural/biped_twin")
+    assert ("Key joints copied from the closest known rig, procedural/biped_twin (surfaces 0.000 of the largest side "
+            "apart).") in item["notes"]
+    armature, _ = the_armature_and_mesh(out)
+    thigh = armature.data.bones["thigh.L"].head_local
+    hip = key_joints(character.skeleton.names, character.skeleton.joints, left_direction=[1.0, 0.0, 0.0],
+                     parents=character.skeleton.parents).positions["hip.L"]
+    np.testing.assert_allclose(np.array(armature.matrix_world @ thigh), hip, atol=1e-5)
+

@@ -135,7 +135,8 @@ def run(args: argparse.Namespace) -> int:
         scene_io.save_scene(output_path)
         details = {"armature": result.armature.name, "bones": result.skeleton.bone_count,
                    "meshes": [obj.name for obj in plan.meshes], "skin": args.skin, "template": result.template,
-                   "body": result.body, "confidence": round(result.confidence, 3), "rigify": result.rigify,
+                   "body": result.body, "confidence": round(result.confidence, 3),
+                   "key_joints_from": result.key_joints_from or None, "rigify": result.rigify,
                    "problems": list(result.problems)}
         if removed:
             details["replaced"] = removed

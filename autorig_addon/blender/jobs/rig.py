@@ -184,7 +184,9 @@ class RigResult:
     prediction and, when it bound the meshes, the skin plan and weights;
     ``template`` is the skeleton built (``biped``, ``quadruped`` or
     ``free-form``), ``body`` and ``confidence`` what the landmark network
-    read the body as and how sure it was, ``rigify`` whether Rigify's control
+    read the body as and how sure it was, ``key_joints_from`` the known rig
+    whose key joints a standard skeleton took (``core.rigging.rig_library``;
+    empty when the landmark network's), ``rigify`` whether Rigify's control
     rig was generated, ``problems`` what the checks found in a poor skeleton
     kept on request."""
 
@@ -196,6 +198,7 @@ class RigResult:
     template: str = ""
     body: str = ""
     confidence: float = 0.0
+    key_joints_from: str = ""
     rigify: bool = False
     problems: tuple = ()
 
@@ -443,6 +446,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                            template=chosen_template(votes, template)[0], rigify=rig is not None, problems=problems)
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
+            if result.template != FREE_FORM:
+                result.key_joints_from = votes.landmarks.copied_from or ""
         if plan.skin is not None:
             with restored_on_failure(bound):
                 if plan.replace:
