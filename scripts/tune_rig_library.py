@@ -15,9 +15,10 @@ network's, the copy's) and, for a range of limits, the mean share when the
 copy replaces the network's landmarks within the limit.
 
 ``--check-screen`` instead checks ``closest_rig``'s screen: on every cached
-training and validation character, read as a biped and as a quadruped, the
-entry it picks at the shipped limit against the one measuring every entry
-in full picks.
+validation and held-out training character, read as a biped and as a
+quadruped, with itself and its near-duplicates out of the library, the entry
+it picks at the shipped limit against the one measuring every entry in full
+picks.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from autorig_addon.core.evaluation.key_joint_metrics import KEY_JOINT_FRACTION
 from autorig_addon.core.geometry.proxy import simplified_proxy
 from autorig_addon.core.rigging import rig_library
 from autorig_addon.core.rigging.joint_features import PROXY_VERTICES
-from autorig_addon.core.rigging.networks.landmarks import sample_landmarks
+from autorig_addon.core.rigging.networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from autorig_addon.core.rigging.predict import _read_shape
 from autorig_addon.core.rigging.rig_library import RigLibrary, closest_rig, shipped_library
 from autorig_addon.core.skeleton.key_joints import KEY_JOINTS
@@ -57,9 +58,7 @@ def near_duplicates(name: str) -> set:
 
 
 def without(library: RigLibrary, names: set) -> RigLibrary:
-    keep = np.array([name not in names for name in library.names])
-    return RigLibrary(library.names[keep], library.kinds[keep], library.points[keep], library.key_joints[keep],
-                      library.known[keep], library.boxes[keep])
+    return library.subset(np.array([name not in names for name in library.names]))
 
 
 def share_right(points: dict, targets: np.ndarray, known: np.ndarray) -> float:
@@ -70,7 +69,9 @@ def share_right(points: dict, targets: np.ndarray, known: np.ndarray) -> float:
 
 def check_screen() -> None:
     split = json.load(open(DEFAULT_SPLIT_FILE))
-    names = {os.path.splitext(path)[0] for path in split["train"] + split["validation"]}
+    trained = sorted(os.path.splitext(path)[0] for path in split["train"])
+    names = {os.path.splitext(path)[0] for path in split["validation"]} | held_out_names(trained)
+    library = shipped_library()
     screened = (rig_library.MEASURED_IN_FULL, rig_library.SCREEN_MARGIN)
     readings, differing = 0, 0
     for path in sorted(Path(default_cache_dir()).glob("*.npz")):
@@ -81,11 +82,12 @@ def check_screen() -> None:
         if sample.name not in names:
             continue
         mesh = Mesh(sample.vertices, sample.triangles)
-        for kind in ("biped", "quadruped"):
+        others = without(library, near_duplicates(sample.name) | {sample.name})
+        for kind in STANDARD_KINDS:
             rig_library.MEASURED_IN_FULL, rig_library.SCREEN_MARGIN = screened
-            quick = closest_rig(mesh, kind)
+            quick = closest_rig(mesh, kind, others)
             rig_library.MEASURED_IN_FULL, rig_library.SCREEN_MARGIN = 10**9, np.inf
-            full = closest_rig(mesh, kind)
+            full = closest_rig(mesh, kind, others)
             readings += 1
             if (quick is None) != (full is None) or (quick is not None and quick.name != full.name):
                 differing += 1
@@ -106,9 +108,9 @@ def main() -> None:
     for sample in samples:
         if sample.name not in held:
             continue
-        targets, known, _ = sample_landmarks(sample)
-        kind = {"humanoid": "biped", "quadruped": "quadruped"}.get(sample.category)
-        if kind is None or not known.any():
+        targets, known, kind_index = sample_landmarks(sample)
+        kind = BODY_KINDS[kind_index]
+        if kind not in STANDARD_KINDS or not known.any():
             continue
         proxy = simplified_proxy(Mesh(sample.vertices, sample.triangles), PROXY_VERTICES).mesh
         landmarks = _read_shape(proxy, normalisation_transform(proxy.vertices), None)[2]

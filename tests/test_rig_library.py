@@ -92,9 +92,10 @@ def test_only_a_rig_of_the_kind_read_and_near_enough_is_copied(library, biped):
     distance = closest_rig(copy, "biped", library).distance
     assert closest_rig(copy, "biped", library, limit=0.5 * distance) is None
     assert closest_rig(copy, "biped", library, limit=2.0 * distance).name == "procedural/biped_0"
-    only_quadruped = RigLibrary(*(array[1:] for array in (library.names, library.kinds, library.points,
-                                                             library.key_joints, library.known, library.boxes)))
-    assert closest_rig(copy, "biped", only_quadruped) is None
+    # Whatever the distance, only an entry of the kind asked for.
+    only_quadruped = library.subset(library.kinds == "quadruped")
+    assert closest_rig(copy, "biped", only_quadruped, limit=np.inf) is None
+    assert closest_rig(copy, "quadruped", library, limit=np.inf).name == "procedural/quadruped_0"
     # A generic body of another shape is no relative at the shipped limit.
     other_biped = procedural("biped", seed=3)[0]
     assert closest_rig(Mesh(other_biped.vertices, other_biped.triangles), "biped", library) is None
@@ -121,13 +122,17 @@ def test_a_character_whose_relative_is_known_gets_its_artist_key_joints(library,
     size = float(np.ptp(character.mesh.vertices, axis=0).max())
     monkeypatch.setattr(rig_library, "shipped_library", lambda: None)
     alone = predict.predict_votes(character.mesh)
-    assert alone.landmarks.copied_from is None
+    assert alone.landmarks.closest_rig is None
     network_errors = key_joint_errors(predict.skeleton_from_votes(alone, template="biped"), character.skeleton, size)
     assert max(network_errors.values()) > 0.05  # measured: the head 0.062, the neck 0.059 off
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
     votes = predict.predict_votes(character.mesh)
-    assert votes.landmarks.copied_from == "procedural/biped_0"
+    assert votes.landmarks.closest_rig.name == "procedural/biped_0"
     assert ("Key joints copied from the closest known rig, procedural/biped_0 (surfaces 0.000 of the largest side "
-            "apart).") in votes.notes
+            "apart).") in predict.template_notes(votes)
     copied_errors = key_joint_errors(predict.skeleton_from_votes(votes, template="biped"), character.skeleton, size)
     assert max(copied_errors.values()) < 1e-6
+    # A quadruped forced on this biped is built on the network's key joints, not on the biped's rig.
+    forced, network_only = (predict.skeleton_from_votes(read, template="quadruped") for read in (votes, alone))
+    np.testing.assert_allclose(forced.joints, network_only.joints, atol=1e-9)
+    assert not any(note.startswith("Key joints copied") for note in predict.template_notes(votes, "quadruped"))

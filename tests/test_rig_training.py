@@ -11,7 +11,7 @@ import pytest
 from autorig_addon.core.nn.spec import shipped_weights
 from autorig_addon.core.nn.weights_io import load_weights
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
-from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS, sample_landmarks
 from autorig_addon.core.rigging.up_features import UP_FEATURE_COUNT
 from autorig_addon.core.skeleton.key_joints import KEY_JOINT_TWINS
 from autorig_addon.training.rigging.proportions import proportion_variant, reproportioned, source_character
@@ -25,7 +25,6 @@ from autorig_addon.training.rigging.landmarks import (  # noqa: E402
     UNTAUGHT_KIND,
     holdout_scores,
     landmark_data,
-    sample_landmarks,
     train_landmark_network,
 )
 from autorig_addon.training.rigging.train import (  # noqa: E402

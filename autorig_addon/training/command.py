@@ -5,12 +5,12 @@ Registered by :mod:`autorig_addon.cli.main` when this package is present
 
 ``train samples`` builds the cached samples of the characters (needs the
 ``bpy`` module); ``train skin --model NAME`` and ``train rig --model NAME``
-train one network from those samples alone, and ``train library`` writes
-the rig library of their key joints (:mod:`.rigging.library`) (torch, no Blender: it also
+train one network from those samples alone (torch, no Blender: it also
 runs on a machine without bpy) and write its weights where the extension
-reads them. Fixed seed, so the
-same command gives the same weights on the same device; see
-``docs/models.md``.
+reads them. Fixed seed, so the same command gives the same weights on the
+same device; see ``docs/models.md``. ``train library`` writes the rig
+library of the training characters' key joints from the same samples
+(:mod:`.rigging.library`; numpy alone).
 """
 
 from __future__ import annotations
@@ -60,8 +60,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--characters", type=Path, default=DEFAULT_CHARACTERS,
                         help="Folder of the rigged characters (train samples; default ../shared/data/characters)")
     parser.add_argument("--output", type=Path, default=None,
-                        help="Weights file to write (default: the extension's own, core/skinning/learned/trained/ "
-                             "or core/rigging/trained/)")
+                        help="Weights file (or, train library, library file) to write (default: the extension's own, "
+                             "core/skinning/learned/trained/ or core/rigging/trained/)")
     parser.add_argument("--no-augment", action="store_true", help="Train on the characters as they are (train skin)")
     parser.add_argument("--procedural", type=int, default=0,
                         help="Also train on this many procedural characters (seeds 0 to N-1, exact skeletons; "

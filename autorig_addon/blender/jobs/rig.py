@@ -446,8 +446,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                            template=chosen_template(votes, template)[0], rigify=rig is not None, problems=problems)
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
-            if result.template != FREE_FORM:
-                result.key_joints_from = votes.landmarks.copied_from or ""
+            copied = votes.landmarks.copied_for(result.template)
+            result.key_joints_from = copied.name if copied is not None else ""
         if plan.skin is not None:
             with restored_on_failure(bound):
                 if plan.replace:

@@ -274,18 +274,20 @@ def _joint_bone_distances(joints: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     return point_segment_distances(joints, segments[:, 0], segments[:, 1])
 
 
-def symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray) -> float:
+def symmetric_chamfer(points_a: np.ndarray, points_b: np.ndarray, tree_a: cKDTree | None = None) -> float:
     """Symmetric Chamfer distance ``(mean_a min_b |a - b| + mean_b min_a |b - a|) / 2``.
 
     Parameters
     ----------
     points_a : (p, 3) float64 array, p >= 1
     points_b : (q, 3) float64 array, q >= 1
+    tree_a : cKDTree of ``points_a``, when the caller already built it (one
+        set measured against many)
 
     Returns
     -------
     distance : float, in the units of the points
     """
     a_to_b = cKDTree(points_b).query(points_a)[0].mean()
-    b_to_a = cKDTree(points_a).query(points_b)[0].mean()
+    b_to_a = (tree_a if tree_a is not None else cKDTree(points_a)).query(points_b)[0].mean()
     return float(a_to_b + b_to_a) / 2.0

@@ -46,6 +46,7 @@ from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph,
 from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
+from .networks.landmarks import STANDARD_KINDS
 from .orientation import stand_upright
 from .quality import skeleton_problems
 from .rig_library import closest_rig
@@ -90,8 +91,6 @@ DEFAULT_SYMMETRY = True
 DEFAULT_TEMPLATE = AUTO
 #: Give a standard biped fingers when its hands have separable ones (:mod:`.fingers`).
 DEFAULT_FINGERS = True
-#: Kinds of body that have a standard skeleton.
-STANDARD_KINDS = ("biped", "quadruped")
 #: Joints this close to the mirror plane, or to their twin's mirror image,
 #: are snapped (share of the bandwidth).
 SNAP_SHARE = 0.5
@@ -242,8 +241,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     notes += leg_notes
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
-    landmarks, library_notes = _closest_rig_key_joints(normalised_surface, landmarks)
-    notes += library_notes
+    if sure_standard_kind(landmarks):
+        landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, landmarks.kind))
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
@@ -259,7 +258,7 @@ def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landm
     length when they put its hip joints far above its crotch
     (:mod:`.leg_length`), mapped back; else ``landmarks`` as they are. Also
     the note saying so."""
-    if landmarks.kind != BIPED or landmarks.confidence < KIND_CONFIDENCE:
+    if sure_standard_kind(landmarks) != BIPED:
         return landmarks, ()
     top = float(normalised.vertices[:, 2].max())
     height_map = short_leg_map(landmarks.points, solid, top)
@@ -272,17 +271,11 @@ def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landm
     return replace(reread, points=points_back(reread.points, stretch, height_map)), (note,)
 
 
-def _closest_rig_key_joints(normalised: Mesh, landmarks: Landmarks) -> tuple[Landmarks, tuple]:
-    """The landmarks of a body read surely as a biped or a quadruped with the
-    key joints of the closest known rig of that kind put in their place when
-    one lies near enough (:mod:`.rig_library`; ``normalised``: the full
-    surface in the normalised frame), and the note saying so; else as they are."""
-    if landmarks.kind not in STANDARD_KINDS or landmarks.confidence < KIND_CONFIDENCE:
-        return landmarks, ()
-    match = closest_rig(normalised, landmarks.kind)
-    if match is None:
-        return landmarks, ()
-    return replace(landmarks, points={**landmarks.points, **match.points}, copied_from=match.name), (match.note,)
+def sure_standard_kind(landmarks: Landmarks) -> str | None:
+    """The kind the landmark network reads, when it is one with a standard
+    skeleton read with at least :data:`.standard_skeleton.KIND_CONFIDENCE`; else None."""
+    sure = landmarks.kind in STANDARD_KINDS and landmarks.confidence >= KIND_CONFIDENCE
+    return landmarks.kind if sure else None
 
 
 def framed_transform(vertices: np.ndarray, rotation: np.ndarray) -> np.ndarray:
@@ -326,7 +319,9 @@ def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton
         return (note,)
     fingerless = (kind == BIPED and fingers and skeleton is not None and votes.surface is not None
                   and not has_fingers(skeleton.names))
-    return (note, *landmark_warnings(votes.landmarks, kind, votes.solid.at),
+    copied = votes.landmarks.copied_for(kind)
+    return (note, *((copied.note,) if copied is not None else ()), *landmark_warnings(votes.landmarks, kind,
+                                                                                     votes.solid.at),
             *((NOT_SEPARABLE_NOTE,) if fingerless else ()))
 
 
@@ -347,7 +342,7 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tupl
     seen = f"the landmark network reads the body as {guess} ({confidence:.0%} sure)"
     if template != AUTO:
         return template, f"Template: standard {template} skeleton, as asked; {seen}."
-    if guess in STANDARD_KINDS and confidence >= KIND_CONFIDENCE:
+    if sure_standard_kind(votes.landmarks):
         return guess, f"Template: standard {guess} skeleton; {seen}."
     return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
                        "force one.")

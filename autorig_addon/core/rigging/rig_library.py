@@ -13,12 +13,14 @@ tail's root, family by family.
 The library (``trained/rig_library.npz``, built by ``train library``)
 holds, per training biped and quadruped whose bone names give key joints,
 :data:`SURFACE_POINTS` points on its normalised surface and its key joints
-in that frame. A character read as one of those kinds takes the key joints
-of the entry of its kind whose surface is nearest (symmetric Chamfer
-distance, in units of the largest side) when that distance is at most
-:data:`LIBRARY_DISTANCE`, mapped by the per-axis affine map between the two
-bounding boxes; the landmark network's stay for the key joints the entry
-lacks (KayKit's rigs have no neck).
+in that frame. A character the landmark network reads surely as one of
+those kinds finds the entry of its kind whose surface is nearest (symmetric
+Chamfer distance, in units of the largest side) when that distance is at
+most :data:`LIBRARY_DISTANCE`; a standard skeleton of that kind (not of a
+kind the user forces instead) takes the entry's key joints, mapped by the
+per-axis affine map between the two bounding boxes, and the landmark
+network's stay for the key joints the entry lacks (KayKit's rigs have no
+neck). Run on a training character, the search finds that character itself.
 """
 
 from __future__ import annotations
@@ -30,11 +32,13 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..evaluation.skeleton_metrics import symmetric_chamfer
 from ..skeleton.key_joints import KEY_JOINT_TWINS, KEY_JOINTS
 from ..types import Mesh
 from .nearest_character import SURFACE_POINTS, box_map, surface_points
-from .networks.landmarks import BODY_KINDS, sample_landmarks
+from .networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from .networks.trained import TRAINED_FOLDER
+from .symmetry import mirror_points
 
 #: The shipped library.
 LIBRARY_FILE = TRAINED_FOLDER / "rig_library.npz"
@@ -44,7 +48,8 @@ LIBRARY_FILE = TRAINED_FOLDER / "rig_library.npz"
 #:
 #: - on the 40 held-out training bipeds and quadrupeds (every sixth by name,
 #:   which the landmark network never trained on), each with itself and its
-#:   near-duplicates out of the library (``scripts/tune_rig_library.py``),
+#:   near-duplicates out of the library and its kind given (the network's raw
+#:   landmarks, without the biped corrections; ``scripts/tune_rig_library.py``),
 #:   key joints within 0.05 are 85.9 % (the network's alone), 87.6 % with a
 #:   limit of 0.015, 86.3 % at 0.02, 87.3 % at 0.025, 87.7 % at 0.03, 86.2 %
 #:   at 0.035: flat from 0.015 to 0.03, one character apart;
@@ -67,10 +72,11 @@ SCREEN_POINTS = 250
 #: the estimate.
 SCREEN_MARGIN = 1.25
 #: Entries measured in full at most, the nearest one way first. On every
-#: cached training and validation character read as either kind (832
-#: readings), the same entry as measuring all of them at the shipped limit
-#: (``scripts/tune_rig_library.py --check-screen``); at a limit of 0.04, 7
-#: differ, each with its nearest entry beyond 0.03.
+#: cached validation and held-out training character read as either kind,
+#: itself and its near-duplicates out of the library, the same entry as
+#: measuring all of them at the shipped limit
+#: (``scripts/tune_rig_library.py --check-screen``: 292 readings, the 92
+#: validation and 54 held-out training characters each read both ways).
 MEASURED_IN_FULL = 16
 
 
@@ -83,7 +89,7 @@ class RigLibrary:
     names : (n,) str, the characters (paths in the data without extension)
     kinds : (n,) str, ``biped`` or ``quadruped``
     points : (n, SURFACE_POINTS, 3) float32, points on each normalised surface
-    key_joints : (n, k, 3) float32, in :data:`...skeleton.key_joints.KEY_JOINTS` order
+    key_joints : (n, k, 3) float32, in :data:`..skeleton.key_joints.KEY_JOINTS` order
     known : (n, k) bool, which key joints each rig has
     boxes : (n, 2, 3) float32, each normalised mesh's bounding box (lowest, highest corner)
     """
@@ -101,6 +107,11 @@ class RigLibrary:
         np.savez_compressed(path, names=self.names, kinds=self.kinds, points=self.points.astype(np.float16),
                             key_joints=self.key_joints.astype(np.float32), known=self.known,
                             boxes=self.boxes.astype(np.float32))
+
+    def subset(self, keep: np.ndarray) -> "RigLibrary":
+        """The entries where ``keep`` (n,) bool is true."""
+        return RigLibrary(self.names[keep], self.kinds[keep], self.points[keep], self.key_joints[keep],
+                          self.known[keep], self.boxes[keep])
 
     @classmethod
     def load(cls, path: Path) -> "RigLibrary":
@@ -121,11 +132,10 @@ class ClosestRig:
 
     @property
     def note(self) -> str:
-        return (f"Key joints copied from the closest known rig, {self.name} (surfaces {self.distance:.3f} of the "
-                f"largest side apart); the landmark network's kept for the {len(KEY_JOINTS) - len(self.points)} "
-                "it lacks." if len(self.points) < len(KEY_JOINTS) else
-                f"Key joints copied from the closest known rig, {self.name} (surfaces {self.distance:.3f} of the "
-                "largest side apart).")
+        copied = (f"Key joints copied from the closest known rig, {self.name} (surfaces {self.distance:.3f} of the "
+                  "largest side apart)")
+        lacking = len(KEY_JOINTS) - len(self.points)
+        return f"{copied}; the landmark network's kept for the {lacking} it lacks." if lacking else f"{copied}."
 
 
 @lru_cache(maxsize=1)
@@ -139,7 +149,7 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     """The entry of ``kind`` whose surface is nearest ``surface`` (normalised
     frame) when at most ``limit`` away, else None.
 
-    Measuring every entry in full would take about a second (160 bipeds).
+    Measuring every entry in full would take about a second (162 bipeds).
     Each entry is first measured one way on :data:`SCREEN_POINTS` of its
     points; then, in that order, at most :data:`MEASURED_IN_FULL` are
     measured in full, and none whose screened half-distance exceeds
@@ -157,13 +167,12 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     screened = target_tree.query(library.points[entries, :SCREEN_POINTS].reshape(-1, 3))[0]
     estimates = screened.reshape(len(entries), -1).mean(axis=1)
     best, best_distance = None, np.inf
-    for order in np.argsort(estimates, kind="stable")[:MEASURED_IN_FULL]:
-        if 0.5 * estimates[order] > SCREEN_MARGIN * min(best_distance, limit):
+    for rank in np.argsort(estimates, kind="stable")[:MEASURED_IN_FULL]:
+        if 0.5 * estimates[rank] > SCREEN_MARGIN * min(best_distance, limit):
             break
-        points = library.points[entries[order]]
-        distance = 0.5 * (target_tree.query(points)[0].mean() + cKDTree(points).query(target)[0].mean())
+        distance = symmetric_chamfer(target, library.points[entries[rank]], target_tree)
         if distance < best_distance:
-            best, best_distance = entries[order], float(distance)
+            best, best_distance = entries[rank], distance
     if best is None or best_distance > limit:
         return None
     low, high = library.boxes[best].astype(np.float64)
@@ -173,10 +182,10 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     return ClosestRig(str(library.names[best]), best_distance, points)
 
 
-#: The kinds the library holds: those with a standard skeleton.
-LIBRARY_KINDS = ("biped", "quadruped")
-#: Largest distance (share of the largest side) from a left key joint's
-#: mirror image to its right twin in an entry: the key-joint tolerance.
+#: Largest distance (share of the largest side) from a key joint's mirror
+#: image to its twin in an entry: the key-joint tolerance. A midline key
+#: joint is its own twin, so one more than half this off the midline also
+#: leaves the entry out.
 MAX_TWIN_MIRROR_ERROR = 0.05
 
 
@@ -187,13 +196,12 @@ def twin_mirror_error(key_joints: np.ndarray, known: np.ndarray) -> float:
     both = known & known[twins]
     if not both.any():
         return 0.0
-    mirrored = key_joints * np.array([-1.0, 1.0, 1.0])
-    return float(np.linalg.norm(mirrored[both] - key_joints[twins][both], axis=1).max())
+    return float(np.linalg.norm(mirror_points(key_joints)[both] - key_joints[twins][both], axis=1).max())
 
 
 def build_rig_library(samples: list) -> RigLibrary:
     """The library of ``samples`` (normalised CharacterSamples), by name:
-    those of a kind of :data:`LIBRARY_KINDS` (the split's category,
+    those of a kind of :data:`.networks.landmarks.STANDARD_KINDS` (the split's category,
     :data:`.networks.landmarks.CATEGORY_KINDS`) whose bone names give a key
     joint (:func:`.networks.landmarks.sample_landmarks`, the landmark
     network's own targets) and whose twin key joints are mirror images
@@ -203,15 +211,15 @@ def build_rig_library(samples: list) -> RigLibrary:
     symmetric."""
     names, kinds, points, key_joints, known, boxes = [], [], [], [], [], []
     for sample in sorted(samples, key=lambda sample: sample.name):
-        targets, has, kind = sample_landmarks(sample)
-        if (BODY_KINDS[kind] not in LIBRARY_KINDS or not has.any()
-                or twin_mirror_error(targets, has > 0) > MAX_TWIN_MIRROR_ERROR):
+        targets, known_joints, kind = sample_landmarks(sample)
+        if (BODY_KINDS[kind] not in STANDARD_KINDS or not known_joints.any()
+                or twin_mirror_error(targets, known_joints > 0) > MAX_TWIN_MIRROR_ERROR):
             continue
         names.append(sample.name)
         kinds.append(BODY_KINDS[kind])
         points.append(surface_points(sample.vertices, sample.triangles, SURFACE_POINTS))
         key_joints.append(targets)
-        known.append(has > 0)
+        known.append(known_joints > 0)
         boxes.append([sample.vertices.min(axis=0), sample.vertices.max(axis=0)])
     return RigLibrary(np.array(names), np.array(kinds), np.array(points, dtype=np.float32),
                       np.array(key_joints, dtype=np.float32), np.array(known, dtype=bool),

@@ -50,6 +50,7 @@ from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_
 from .joint_features import JointGraph
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS
+from .rig_library import ClosestRig
 
 BIPED, QUADRUPED, OTHER = BODY_KINDS
 #: Template choices: the network's guess, one kind forced, or the free-form skeleton.
@@ -86,13 +87,13 @@ class Landmarks:
     ----------
     points : dict mapping each name of :data:`LANDMARKS` to its (3,) position
     kind_probabilities : dict mapping each kind of :data:`BODY_KINDS` to its probability
-    copied_from : str, the known rig whose key joints replaced the network's
-        (:mod:`.rig_library`); None when they are the network's own
+    closest_rig : ClosestRig, the known rig of the kind read whose key joints
+        stand in for the network's (:mod:`.rig_library`); None when none lies near
     """
 
     points: dict
     kind_probabilities: dict
-    copied_from: str | None = None
+    closest_rig: ClosestRig | None = None
 
     @property
     def kind(self) -> str:
@@ -101,6 +102,18 @@ class Landmarks:
     @property
     def confidence(self) -> float:
         return float(self.kind_probabilities[self.kind])
+
+    def copied_for(self, kind: str) -> ClosestRig | None:
+        """The known rig whose key joints a standard skeleton of ``kind`` takes:
+        the closest rig only for the kind it was found for (a biped forced
+        on a body read as a quadruped keeps the network's points)."""
+        return self.closest_rig if kind == self.kind else None
+
+    def points_for(self, kind: str) -> dict:
+        """The key joints a standard skeleton of ``kind`` is built on: the
+        network's, with those of :meth:`copied_for` in their place."""
+        copied = self.copied_for(kind)
+        return self.points if copied is None else {**self.points, **copied.points}
 
 
 def predict_landmarks(graph: JointGraph, weights: dict | None = None) -> Landmarks:
@@ -471,8 +484,9 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
     tuple of str: key joints outside the body, and a leg whose joints do not
     go down from the hip to the ankle.
     """
-    names = list(landmarks.points)
-    points = np.array([landmarks.points[name] for name in names])
+    placed = landmarks.points_for(kind)
+    names = list(placed)
+    points = np.array([placed[name] for name in names])
     depth = np.asarray(inside(points)).reshape(-1)
     notes = []
     outside = [_spoken(name, kind) for name, value in zip(names, depth) if value <= 0.0]
@@ -481,7 +495,7 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
     legs = [("hip", "knee", "ankle")] + ([("shoulder", "elbow", "wrist")] if kind == QUADRUPED else [])
     for chain in legs:
         for side in (LEFT, RIGHT):
-            heights = [landmarks.points[role + side][2] for role in chain]
+            heights = [placed[role + side][2] for role in chain]
             if not heights[0] > heights[1] > heights[2]:
                 notes.append(f"check the skeleton: the {_spoken(chain[0] + side, kind)}, "
                              f"{_spoken(chain[1] + side, kind)} and {_spoken(chain[2] + side, kind)} do not go "
@@ -495,8 +509,8 @@ def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, sym
     landmarks, in the normalised frame; a biped gets fingers when
     ``surface`` (the full-resolution mesh, normalised) is given and both
     hands have separable ones (:func:`both_hands_fingers`)."""
-    points = symmetrised(landmarks.points, symmetric_shape)
-    if kind == BIPED and landmarks.copied_from is None:
+    points = symmetrised(landmarks.points_for(kind), symmetric_shape)
+    if kind == BIPED and landmarks.copied_for(kind) is None:
         # These correct where the network puts a biped's joints; an artist's rig copied whole is left as it is.
         points = head_near_neck(hips_at_most_at_hip_joints(points))
         # Each arm is read on its own side; a symmetric shape's shoulders and wrists stay mirror images.

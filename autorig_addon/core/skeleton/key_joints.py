@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .hierarchy import ancestors
+from .naming import mirror_name
 
 #: Roles on the midline, then the roles every side has.
 MIDLINE_ROLES = ("hips", "neck", "head")
@@ -36,8 +37,7 @@ LEFT, RIGHT = ".L", ".R"
 #: The fifteen key joints, in report order.
 KEY_JOINTS = MIDLINE_ROLES + tuple(role + side for side in (LEFT, RIGHT) for role in SIDE_ROLES)
 #: Index in :data:`KEY_JOINTS` of each key joint's mirror twin (its own on the midline).
-KEY_JOINT_TWINS = tuple(KEY_JOINTS.index(name.replace(LEFT, "#").replace(RIGHT, LEFT).replace("#", RIGHT))
-                        for name in KEY_JOINTS)
+KEY_JOINT_TWINS = tuple(KEY_JOINTS.index(mirror_name(name)) for name in KEY_JOINTS)
 #: Placeholder for the side spelling in a convention's bone names.
 SIDE = "{s}"
 

@@ -45,6 +45,7 @@ from ...core.nn.spec import NetworkSpec
 from ...core.rigging.connectivity import bone_probabilities, root_scores
 from ...core.rigging.joint_features import VERTEX_VECTORS, solid_depth
 from ...core.rigging.networks import rig_network
+from ...core.rigging.networks.landmarks import sample_landmarks
 from ...core.rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, cluster_joints, graph_votes
 from ...core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from ...core.rigging.tree_features import candidate_pairs, pair_features, root_features
@@ -63,7 +64,7 @@ from ..runs import (
     start_run,
     write_weights,
 )
-from .landmarks import sample_landmarks, train_landmark_network
+from .landmarks import train_landmark_network
 from .proportions import DEFAULT_PROPORTION_VARIANTS, reshaped_variants
 from .training_set import EXAMPLE_FORMAT_VERSION, RigExample, build_examples
 from .upright import copies_per_character, upright_data

@@ -29,6 +29,8 @@ from .trained import TRAINED_FOLDER
 LANDMARKS = KEY_JOINTS
 #: Kinds of body the network tells apart, in output order.
 BODY_KINDS = ("biped", "quadruped", "other")
+#: The kinds with a standard skeleton.
+STANDARD_KINDS = BODY_KINDS[:2]
 #: The split's kinds of character (and the procedural generator's) and the body kind each teaches.
 CATEGORY_KINDS = {"humanoid": "biped", "quadruped": "quadruped", "biped": "biped"}
 
