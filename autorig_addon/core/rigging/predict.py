@@ -320,8 +320,8 @@ def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton
     fingerless = (kind == BIPED and fingers and skeleton is not None and votes.surface is not None
                   and not has_fingers(skeleton.names))
     copied = votes.landmarks.copied_for(kind)
-    return (note, *((copied.note,) if copied is not None else ()), *landmark_warnings(votes.landmarks, kind,
-                                                                                     votes.solid.at),
+    copy_notes = (copied.note,) if copied is not None else ()
+    return (note, *copy_notes, *landmark_warnings(votes.landmarks, kind, votes.solid.at),
             *((NOT_SEPARABLE_NOTE,) if fingerless else ()))
 
 
