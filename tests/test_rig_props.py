@@ -369,3 +369,25 @@ def test_auto_rig_replacing_a_rig_takes_a_sword_in_each_hand_off_the_hand_bones_
         assert f"'{name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
     assert_bound_wholly_to(sword, armature, "hand.R")
     assert_wholly_on(offhand, armature, "hand.L")
+
+
+def test_auto_rig_replacing_a_posed_rig_takes_the_swords_where_they_are_at_rest(clean_scene):
+    """The old rig posed in the scene (the right forearm turned 60 degrees,
+    carrying the sword 0.34 m away): the body is rigged at rest, and so is
+    the sword, bound to the new right hand where the old rig's rest put it.
+    Before, unbinding kept the sword where the pose held it, so at the new
+    rig's rest it floated 0.34 m from the hand."""
+    body, sword, offhand = add_body_with_a_sword_in_each_hand_on_a_rig()
+    sword_at_rest = evaluated_world_vertices(sword)
+    pose_bone_turned(bpy.data.objects["Rig"], "forearm.R", 60.0)
+    assert np.abs(evaluated_world_vertices(sword) - sword_at_rest).max() > 0.3
+    select_only([body, sword, offhand], active=body)
+
+    assert bpy.ops.autorig.auto_rig(rig_replace=True) == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert armature.data.pose_position == "POSE"
+    for pose_bone in armature.pose.bones:
+        assert tuple(pose_bone.rotation_quaternion) == (1.0, 0.0, 0.0, 0.0)
+    np.testing.assert_allclose(evaluated_world_vertices(sword), sword_at_rest, atol=1e-5)
+    assert_bound_wholly_to(sword, armature, "hand.R")

@@ -56,7 +56,15 @@ from ...core.skeleton.checks import skeleton_extent
 from ...core.skeleton.name_presets import DEFAULT_PRESET
 from ...core.types import Mesh, Skeleton
 from .. import convert
-from ..armature_binding import armature_bindings, bound_armature, deforms, followers, remove_armature, unbind
+from ..armature_binding import (
+    armature_bindings,
+    bound_armature,
+    deforms,
+    followers,
+    objects_at_rest,
+    remove_armature,
+    unbind,
+)
 from ..armature_builder import build_armature
 from ..modifier_stack import (
     DEFORM_ONLY_TYPES,
@@ -451,8 +459,11 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
         if plan.skin is not None:
             with restored_on_failure(bound):
                 if plan.replace:
-                    for obj in bound:
-                        unbind(obj)
+                    # At rest, as the rest shape was read: what the old rig's pose moved (a sword on a posed
+                    # hand's bone) stays where it is at rest, not where the pose held it.
+                    with objects_at_rest(bound):
+                        for obj in bound:
+                            unbind(obj)
                 skin_plan = plan_skin(target, plan.meshes, plan.skin, context.evaluated_depsgraph_get(),
                                       named=plan.named, left_out=plan.left_out, held=plan.held,
                                       held_pieces=plan.held_pieces)
