@@ -82,7 +82,8 @@ def test_without_a_shape_cue_the_surer_reading_turned_decides():
     block = boxes(([-0.2, -0.2, 0.0], [0.2, 0.2, 1.0]))
     assert facing(landmarks_of(UNSURE), landmarks_of(SURE_BIPED), block) == Facing(
         True, reason="turned, it reads more surely as a biped")
-    assert facing(landmarks_of(UNSURE), landmarks_of(UNSURE), block) == Facing(False)
+    # Read as "other" both ways: kept as given, and nothing told its front.
+    assert facing(landmarks_of(UNSURE), landmarks_of(UNSURE), block) == Facing(False, front_untold=True)
 
 
 def test_a_quadrupeds_higher_end_is_its_front():

@@ -156,11 +156,26 @@ class Facing:
         behind (:func:`from_behind`): the reading of it turned half a turn, or,
         when it is turned, the reading of it as it was given
     reason : str, what told it, for the report ("its toes point toward +Y", "its toes point that way")
+    front_untold : bool, nothing told its front: read neither way as a biped or quadruped, it is taken
+        to face -y as it was given (:data:`FRONT_UNTOLD_NOTE`)
     """
 
     turn: bool
     read_from_behind: bool = False
     reason: str = ""
+    front_untold: bool = False
+
+
+#: The report's note when nothing tells which way a body faces. Its shape
+#: alone does not: a linear score of the front-to-back profile (area,
+#: height, width and spread per band) told the front of only half of the
+#: validation fish, flyers and blobs (docs/rigging.md, *Orientation*).
+FRONT_UNTOLD_NOTE = (
+    "Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either way "
+    "round): it was taken to face -Y as it stands (after any turn noted above), as in Blender's front view, so "
+    "its .L bones lie on the side then at +X and a chain running toward +Y is its tail. If it faces another way, "
+    "turn it to face -Y (or choose a template) and predict again."
+)
 
 
 def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
@@ -197,7 +212,7 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
         return Facing(True, reason=f"turned, it reads more surely as {kind}")
     if landmarks.kind == BIPED and _feet_behind_ankles(landmarks, surface.vertices):
         return Facing(True, reason="its feet reach further behind its ankles than ahead")
-    return Facing(False)
+    return Facing(False, front_untold=kinds == (OTHER, OTHER))
 
 
 def _keeps_the_head_end(reading: Landmarks, shape_kind: str) -> bool:

@@ -40,7 +40,7 @@ from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
-from .facing import facing, from_behind, half_turned
+from .facing import FRONT_UNTOLD_NOTE, facing, from_behind, half_turned
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
@@ -233,6 +233,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
                      "prediction, so its .L bones lie on its own left.")
+    elif way.front_untold:
+        notes.append(FRONT_UNTOLD_NOTE)
     if way.read_from_behind:
         landmarks = from_behind(turned)
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
