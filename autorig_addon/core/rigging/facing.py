@@ -168,8 +168,9 @@ class Facing:
 
 #: The report's note when nothing tells which way a body faces. Its shape
 #: alone does not: a linear score of the front-to-back profile (area,
-#: height, width and spread per band) told the front of only half of the
-#: validation fish, flyers and blobs (docs/rigging.md, *Orientation*).
+#: height, width and spread per band) told the front of 14 of the 23
+#: validation fish, flyers and monsters (``scripts/check_front_profile.py``;
+#: docs/rigging.md, *Orientation*).
 FRONT_UNTOLD_NOTE = (
     "Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either way "
     "round): it was taken to face -Y as it stands (after any turn noted above), as in Blender's front view, so "
