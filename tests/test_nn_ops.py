@@ -96,13 +96,19 @@ def test_activations_and_linear():
     x = np.array([-2.0, -0.5, 0.0, 1.5])
     assert relu(x).tolist() == [0, 0, 0, 1.5]
     assert leaky_relu(x).tolist() == [-0.02, -0.005, 0, 1.5]
-    # The larger of x and slope * x is the same, bit for bit, as x where positive, NaN and -0 kept.
-    many = np.concatenate([np.random.default_rng(0).normal(size=1000), [np.nan, -0.0, 0.0, -1e-45]]).astype(np.float32)
-    assert np.array_equal(leaky_relu(many), np.where(many > 0, many, many * np.float32(0.01)), equal_nan=True)
-    assert np.signbit(leaky_relu(np.array([-0.0], np.float32)))[0]
-    assert leaky_relu(many, 0.2).dtype == np.float32
-    with pytest.raises(ValueError, match="slope in"):
-        leaky_relu(x, 1.5)
+    # The larger of x and slope * x is the same, bit for bit, as x where positive: infinities, NaN, -0 and
+    # subnormals too, in either precision.
+    special = [np.nan, -0.0, 0.0, np.inf, -np.inf, -1e-45, 1e-45]
+    for dtype, bits in ((np.float32, np.uint32), (np.float64, np.uint64)):
+        many = np.concatenate([np.random.default_rng(0).normal(size=1000), special]).astype(dtype)
+        for slope in (0.01, 0.2):
+            expected = np.where(many > 0, many, many * dtype(slope))
+            result = leaky_relu(many, slope)
+            assert result.dtype == dtype and np.array_equal(result.view(bits), expected.view(bits))
+    assert leaky_relu(np.array(-2.0)) == -0.02
+    for slope in (0.0, 1.0, 1.5):
+        with pytest.raises(ValueError, match="slope in"):
+            leaky_relu(x, slope)
     weight = np.array([[1.0, 2.0], [0.0, -1.0], [3.0, 0.5]])  # (out 3, in 2)
     assert linear(np.array([[1.0, 1.0], [2.0, 0.0]]), weight, np.array([0.0, 1.0, -1.0])).tolist() == \
         [[3, 0, 2.5], [2, 1, 5]]

@@ -17,7 +17,7 @@ from autorig_addon.core.evaluation.skeleton_metrics import chamfer_j2j, evaluate
 from autorig_addon.core.geometry.bounding_box import largest_side
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import connectivity, mean_shift, predict, symmetry, tree_features
-from autorig_addon.core.rigging.facing import FRONT_UNTOLD_NOTE
+from autorig_addon.core.rigging.facing import front_untold_note
 from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
 from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
@@ -681,12 +681,18 @@ def test_the_note_says_how_the_character_was_found_and_turned():
 
 def test_a_body_read_neither_way_as_a_biped_or_quadruped_says_its_front_was_not_told():
     """A fish reads as "other" facing -Y and +Y alike, so nothing tells its
-    front: the report says it was taken to face -Y and what that means for
-    its .L bones and tail. A biped, whose toes tell, does not say it."""
+    front: the report names the axis of the mesh it was taken to face (+-X
+    for one turned a quarter) and what that means for its .L bones and tail.
+    A biped, whose toes tell, does not say it."""
     fish = generate_character(0, "fish").mesh
-    assert FRONT_UNTOLD_NOTE in predict.predict_votes(fish).notes
-    assert FRONT_UNTOLD_NOTE in predict.predict_votes(Mesh(fish.vertices * [-1.0, -1.0, 1.0], fish.triangles)).notes
-    assert FRONT_UNTOLD_NOTE not in predict.predict_votes(generate_character(BIPED_SEED, "biped").mesh).notes
+    assert front_untold_note("-Y") in predict.predict_votes(fish).notes
+    half_turned = Mesh(fish.vertices * [-1.0, -1.0, 1.0], fish.triangles)
+    assert front_untold_note("-Y") in predict.predict_votes(half_turned).notes
+    quarter = Mesh(fish.vertices[:, [1, 0, 2]] * [-1.0, 1.0, 1.0], fish.triangles)
+    notes = predict.predict_votes(quarter).notes
+    assert front_untold_note("+X") in notes or front_untold_note("-X") in notes
+    biped_notes = predict.predict_votes(generate_character(BIPED_SEED, "biped").mesh).notes
+    assert not any(note.startswith("Which way the character faces") for note in biped_notes)
 
 
 def test_a_shape_lying_on_its_side_that_stands_up_no_way_as_a_body_is_refused():

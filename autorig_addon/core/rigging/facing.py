@@ -157,7 +157,7 @@ class Facing:
         when it is turned, the reading of it as it was given
     reason : str, what told it, for the report ("its toes point toward +Y", "its toes point that way")
     front_untold : bool, nothing told its front: read neither way as a biped or quadruped, it is taken
-        to face -y as it was given (:data:`FRONT_UNTOLD_NOTE`)
+        to face -y as it was given (:func:`front_untold_note`)
     """
 
     turn: bool
@@ -166,17 +166,17 @@ class Facing:
     front_untold: bool = False
 
 
-#: The report's note when nothing tells which way a body faces. Its shape
-#: alone does not: a linear score of the front-to-back profile (area,
-#: height, width and spread per band) told the front of 14 of the 23
-#: validation fish, flyers and monsters (``scripts/check_front_profile.py``;
-#: docs/rigging.md, *Orientation*).
-FRONT_UNTOLD_NOTE = (
-    "Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either way "
-    "round): it was taken to face -Y as it stands (after any turn noted above), as in Blender's front view, so "
-    "its .L bones lie on the side then at +X and a chain running toward +Y is its tail. If it faces another way, "
-    "turn it to face -Y (or choose a template) and predict again."
-)
+def front_untold_note(front: str) -> str:
+    """The report's note when nothing tells which way a body faces
+    (``front``: the mesh-space axis it was taken to face, '-Y', '+X'...).
+    Its shape alone does not: a linear score of the front-to-back profile
+    (area, height, width and spread per band) told the front of 14 of the 23
+    validation fish, flyers and monsters (``scripts/check_front_profile.py``;
+    docs/rigging.md, *Orientation*)."""
+    return (f"Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either "
+            f"way round): it was taken to face {front} of its own space, so its .L bones lie on its left seen so, and "
+            "a chain running away from that end is its tail. If it faces another way, turn it to face -Y and predict "
+            "again.")
 
 
 def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:

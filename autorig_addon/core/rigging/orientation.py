@@ -273,7 +273,7 @@ class Stance:
     notes: tuple = ()
 
 
-def _axis_name(direction: np.ndarray) -> str:
+def axis_name(direction: np.ndarray) -> str:
     """'+Y', '-Z'... for a direction near an axis, else its rounded components."""
     axis = int(np.argmax(np.abs(direction)))
     if abs(direction[axis]) >= np.cos(np.radians(AXIS_SNAP_DEGREES)):
@@ -381,6 +381,6 @@ def _facing_notes(frame: np.ndarray) -> list[str]:
 
 def _turn_note(rotation: np.ndarray, how: str, landmarks) -> str:
     up = rotation[2]  # the mesh-space direction the frame's +z is
-    return (f"The character {how} (its up is {_axis_name(up)} of its own space; stood up, it reads as a "
+    return (f"The character {how} (its up is {axis_name(up)} of its own space; stood up, it reads as a "
             f"{landmarks.kind}, {landmarks.confidence:.0%} sure): it was stood upright for the prediction, and the "
             "skeleton is turned back with it.")

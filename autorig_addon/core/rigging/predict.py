@@ -40,14 +40,14 @@ from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
-from .facing import FRONT_UNTOLD_NOTE, facing, from_behind, half_turned
+from .facing import facing, from_behind, front_untold_note, half_turned
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .networks.landmarks import STANDARD_KINDS
-from .orientation import stand_upright
+from .orientation import axis_name, stand_upright
 from .quality import skeleton_problems
 from .rig_library import closest_rig
 from .role_names import role_names
@@ -234,7 +234,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
                      "prediction, so its .L bones lie on its own left.")
     elif way.front_untold:
-        notes.append(FRONT_UNTOLD_NOTE)
+        notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
     if way.read_from_behind:
         landmarks = from_behind(turned)
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
