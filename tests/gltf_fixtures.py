@@ -1,5 +1,6 @@
 """Binary glTF files with skins, written byte by byte (no Blender)."""
 
+import base64
 import json
 
 import numpy as np
@@ -66,3 +67,97 @@ def write_rig_glb(path, names, parents, extras=None) -> None:
     weights = np.zeros((count, 4), np.uint8)
     weights[:, 0] = 255
     write_glb(path, *skinned_document(names, parents, joints, weights, extras))
+
+
+def box_surface(low, high, segments: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and outward triangles of the box ``low``..``high``, each face
+    cut into ``segments`` x ``segments`` squares."""
+    low, high = np.asarray(low, float), np.asarray(high, float)
+    vertices, triangles = [], []
+    for axis in range(3):
+        u, v = [other for other in range(3) if other != axis]
+        for side, corner in enumerate((low, high)):
+            start = len(vertices)
+            for i in range(segments + 1):
+                for j in range(segments + 1):
+                    point = np.empty(3)
+                    point[axis] = corner[axis]
+                    point[u] = low[u] + (high[u] - low[u]) * i / segments
+                    point[v] = low[v] + (high[v] - low[v]) * j / segments
+                    vertices.append(point)
+            for i in range(segments):
+                for j in range(segments):
+                    a = start + i * (segments + 1) + j
+                    b, c, d = a + segments + 1, a + 1, a + segments + 2
+                    # Wound so the normal leaves the box on both sides of each axis.
+                    flip = (side == 1) == (axis == 1)
+                    triangles += [(a, c, b), (c, d, b)] if flip else [(a, b, c), (c, b, d)]
+    return np.array(vertices), np.array(triangles)
+
+
+def _y_up(points) -> np.ndarray:
+    """Blender's Z-up coordinates as glTF's Y-up ones."""
+    points = np.asarray(points, float)
+    return np.stack([points[..., 0], points[..., 2], -points[..., 1]], axis=-1)
+
+
+def write_box_character_gltf(path, bones) -> None:
+    """A .gltf (buffer embedded) of boxes skinned rigidly to joints whose frames
+    are never turned (no node rotation), as Kenney's minis are exported.
+
+    Parameters
+    ----------
+    bones : sequence of (name, parent index or -1, head in Blender's Z-up
+        coordinates, (low, high) corners of the box it carries or None)
+    """
+    positions, triangles, owners = [], [], []
+    for joint, (_, _, _, extent) in enumerate(bones):
+        if extent is None:
+            continue
+        vertices, faces = box_surface(*extent)
+        triangles.append(faces + sum(len(block) for block in positions))
+        positions.append(vertices)
+        owners += [joint] * len(vertices)
+    positions = _y_up(np.vstack(positions)).astype(np.float32)
+    indices = np.vstack(triangles).astype(np.uint16).ravel()
+    joint_ids = np.zeros((len(positions), 4), np.uint8)
+    joint_ids[:, 0] = owners
+    weights = np.zeros((len(positions), 4), np.float32)
+    weights[:, 0] = 1.0
+    heads = _y_up([head for _, _, head, _ in bones])
+    inverse_binds = []
+    for head in heads:
+        matrix = np.eye(4)
+        matrix[:3, 3] = -head
+        inverse_binds.append(matrix.T.ravel())  # glTF matrices are column-major
+    blobs = [positions.tobytes(), joint_ids.tobytes(), weights.tobytes(), indices.tobytes(),
+             np.array(inverse_binds, np.float32).tobytes()]
+    padded = [blob + b"\0" * (-len(blob) % 4) for blob in blobs]
+    offsets = np.cumsum([0] + [len(blob) for blob in padded])
+    buffer = b"".join(padded)
+    nodes = [{"name": name, "translation": [float(x) for x in heads[joint] - (heads[parent] if parent >= 0 else 0)]}
+             for joint, (name, parent, _, _) in enumerate(bones)]
+    for joint, (_, parent, _, _) in enumerate(bones):
+        if parent >= 0:
+            nodes[parent].setdefault("children", []).append(joint)
+    roots = [joint for joint, (_, parent, _, _) in enumerate(bones) if parent < 0]
+    nodes.append({"name": "Body", "mesh": 0, "skin": 0})
+    document = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": roots + [len(nodes) - 1]}], "nodes": nodes,
+        "meshes": [{"name": "Body", "primitives": [
+            {"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}, "indices": 3}]}],
+        "skins": [{"joints": list(range(len(bones))), "inverseBindMatrices": 4, "skeleton": roots[0]}],
+        "buffers": [{"byteLength": len(buffer),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii")}],
+        "bufferViews": [{"buffer": 0, "byteOffset": int(offset), "byteLength": len(blob)}
+                        for offset, blob in zip(offsets, blobs)],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3",
+             "min": positions.min(0).tolist(), "max": positions.max(0).tolist()},
+            {"bufferView": 1, "componentType": 5121, "count": len(positions), "type": "VEC4"},
+            {"bufferView": 2, "componentType": 5126, "count": len(positions), "type": "VEC4"},
+            {"bufferView": 3, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
+            {"bufferView": 4, "componentType": 5126, "count": len(bones), "type": "MAT4"},
+        ],
+    }
+    path.write_text(json.dumps(document), encoding="utf-8")

@@ -18,6 +18,7 @@ from autorig_addon.core.skeleton.tails import (
     with_reliable_tails,
 )
 from autorig_addon.core.types import Skeleton
+from gltf_fixtures import write_box_character_gltf
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -341,3 +342,98 @@ def test_point_like_bone_above_mirrored_children_continues_its_parent_line():
     np.testing.assert_allclose(fixed.tails[[0, 2, 3]], skeleton.tails[[0, 2, 3]])
     assert decision.derived == ("pelvis",)
     assert decision.note.endswith("continue their parent's line between mirrored children")
+
+
+# --------------------------------------------------------------------------- bones all pointing one way
+
+
+def one_way(skeleton: Skeleton, direction=(0.0, 1.0, 0.0), bones=None) -> Skeleton:
+    """``skeleton`` with its bones (all, or the indices ``bones``) turned to
+    ``direction``, lengths kept: what Blender's glTF importer makes of a file
+    whose joint frames were never turned (Kenney's minis)."""
+    tails = skeleton.tails.copy()
+    chosen = np.arange(skeleton.bone_count) if bones is None else np.asarray(bones)
+    tails[chosen] = skeleton.joints[chosen] + skeleton.bone_lengths[chosen, None] * np.asarray(direction)
+    return Skeleton(skeleton.joints, skeleton.parents, skeleton.names, tails, skeleton.deform)
+
+
+def test_bones_all_pointing_one_way_and_not_at_their_children_get_derived_tails():
+    real = biped()
+    turned = one_way(real)
+    assessment = assess_stored_tails(turned, 2.0)
+    assert assessment.one_way_share == 1.0 and assessment.direction_agreement == 0.0
+    assert not assessment.usable
+    fixed, decision = with_reliable_tails(turned, 2.0)
+    # Every bone with a child ends on it; the shins continue their thighs' line
+    # down to where the real ones end; only the head (a leaf) is a guess.
+    np.testing.assert_allclose(fixed.tails[:4], real.tails[:4], atol=1e-12)
+    np.testing.assert_allclose(fixed.tails[5:], real.tails[5:], atol=1e-12)
+    head_line = real.joints[4] - real.joints[3]
+    np.testing.assert_allclose(fixed.tails[4], real.joints[4] + LEAF_LENGTH_FRACTION * head_line)
+    assert decision.whole_armature
+    assert decision.note == ("bone tails derived from the joints: the stored bones all point one way "
+                             "(100 % of them), not at their children (0 % do): the importer's joint axis, "
+                             "not the bones")
+
+
+def test_one_way_bones_are_kept_below_the_share_or_when_they_point_at_their_children():
+    real = biped()
+    # 8 of the 9 bones one way (89 %) is below ONE_WAY_SHARE: kept.
+    most = one_way(real, bones=range(8))
+    assessment = assess_stored_tails(most, 2.0)
+    assert assessment.one_way_share == pytest.approx(8 / 9) and assessment.usable
+    # A straight vertical chain (a tentacle, a fish's spine) points one way, at its children: real bones.
+    joints = np.array([[0, 0, 0], [0, 0, 1.0], [0, 0, 2.0], [0, 0, 3.0]])
+    chain = Skeleton(joints, [-1, 0, 1, 2], ("a", "b", "c", "d"), joints + [0, 0, 1.0])
+    fixed, decision = with_reliable_tails(chain, 5.0)
+    assert assess_stored_tails(chain, 5.0).one_way_share == 1.0
+    assert fixed is chain and not decision.any_derived
+    # Parallel bones with no children (a curtain of roots) have no children to disagree with: kept.
+    roots = Skeleton(joints * [0, 0, 0] + [[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]], [-1, -1, -1, -1],
+                     ("a", "b", "c", "d"), joints * [0, 0, 0] + [[0, 0, 1], [1, 0, 1], [2, 0, 1], [3, 0, 1]])
+    assert assess_stored_tails(roots, 5.0).usable
+    # Two bones are too few to tell an importer's axis from a rig.
+    pair = Skeleton([[0, 0, 0], [1.0, 0, 0]], [-1, 0], ("a", "b"), [[0, 0, 1.0], [1.0, 0, 1.0]])
+    assert assess_stored_tails(pair, 3.0).one_way_share == 0.0 and assess_stored_tails(pair, 3.0).usable
+
+
+#: A blocky character as Kenney's minis are laid out: the root on the floor,
+#: the legs hanging from the hips, the torso and head a few centimetres off
+#: the root's vertical; (name, parent, head, box it carries).
+UNTURNED_MINI = (
+    ("root", -1, (0.0, 0.0, 0.0), None),
+    ("leg.L", 0, (0.1, 0.0, 0.2), ((0.04, -0.05, 0.0), (0.16, 0.05, 0.2))),
+    ("leg.R", 0, (-0.1, 0.0, 0.2), ((-0.16, -0.05, 0.0), (-0.04, 0.05, 0.2))),
+    ("torso", 0, (0.0, -0.03, 0.2), ((-0.18, -0.1, 0.2), (0.18, 0.1, 0.5))),
+    ("head", 3, (0.0, 0.02, 0.5), ((-0.2, -0.15, 0.5), (0.2, 0.15, 0.85))),
+)
+
+
+def test_gltf_joints_never_turned_get_bones_along_the_hierarchy(clean_scene, tmp_path):
+    import bpy
+
+    from autorig_addon.blender import characters, convert
+    from autorig_addon.core.skinning.methods import DEFAULT_SKIN_METHOD, skin_weights
+    from autorig_addon.core.skinning.options import SkinningOptions
+
+    path = tmp_path / "mini.gltf"
+    write_box_character_gltf(path, UNTURNED_MINI)
+    character = characters.load_character(path)
+    stored = convert.read_skeleton(bpy.data.objects[character.armature_name])
+    # Blender's importer points every bone up, along the unturned joint frames: the legs into the torso.
+    directions = stored.tails - stored.joints
+    np.testing.assert_allclose(directions / np.linalg.norm(directions, axis=1, keepdims=True),
+                               np.tile(UP, (5, 1)), atol=1e-6)
+    skeleton = character.skeleton
+    heads = np.array([head for _, _, head, _ in UNTURNED_MINI])
+    np.testing.assert_allclose(skeleton.joints, heads, atol=1e-6)
+    np.testing.assert_allclose(skeleton.tails[3], heads[4], atol=1e-6)  # the torso ends at the head
+    # The legs (leaves) continue the line from the root through the hips, out and up, no longer along the torso.
+    np.testing.assert_allclose(skeleton.tails[1], heads[1] + LEAF_LENGTH_FRACTION * heads[1], atol=1e-6)
+    assert ("bone tails derived from the joints: the stored bones all point one way (100 % of them), not at their "
+            "children (0 % do): the importer's joint axis, not the bones") in character.notes
+    # The default network then gives most of the torso box to the torso (47 % along the stored bones).
+    weights = skin_weights(character.mesh, skeleton, SkinningOptions(method=DEFAULT_SKIN_METHOD))
+    torso_box = character.weights.matrix[:, character.weights.bone_names.index("torso")] > 0.5
+    dominant = np.array(weights.bone_names)[weights.matrix.argmax(axis=1)]
+    assert np.mean(dominant[torso_box] == "torso") > 2 / 3

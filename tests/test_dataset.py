@@ -261,18 +261,17 @@ def test_sample_without_notes_round_trips(tmp_path):
 
 
 def test_loading_another_format_version_is_an_input_error(tmp_path):
-    # Format 3: samples of format 2 (before the facing read the deform bones
-    # near the body and the head ahead of the tail, and without the
-    # normalisation's and the rest pose's notes) must be rebuilt.
-    assert SAMPLE_FORMAT_VERSION == 3
+    # Format 4: samples of format 3 (whose bones, when the importer pointed
+    # them all one way, kept those tails) must be rebuilt.
+    assert SAMPLE_FORMAT_VERSION == 4
     sample, _, _ = make_sample()
     path = tmp_path / "old.npz"
     sample.save(path)
     with np.load(path) as data:
         arrays = dict(data)
-    arrays["format_version"] = np.int64(2)
+    arrays["format_version"] = np.int64(3)
     np.savez(path, **arrays)
-    with pytest.raises(InputError, match="'old.npz' is a sample of format 2, this version reads 3: delete it"):
+    with pytest.raises(InputError, match="'old.npz' is a sample of format 3, this version reads 4: delete it"):
         CharacterSample.load(path)
     with pytest.raises(InputError, match="The sample file '.*missing.npz' does not exist"):
         CharacterSample.load(tmp_path / "missing.npz")

@@ -20,8 +20,10 @@ from .normalise import FACING_UNKNOWN, normalise
 #: as ``bip01 l hand`` understood) and from the head ahead of the tail when the
 #: side names disagree; the normalisation's scale and facing, the rest pose,
 #: rigid weights and the Mixamo-name weight check noted; ``category`` is the
-#: split's kind (humanoid, quadruped, bird, fish, other).
-SAMPLE_FORMAT_VERSION = 3
+#: split's kind (humanoid, quadruped, bird, fish, other). 4: stored bones
+#: that all point one way, not at their children (unturned joint frames),
+#: get tails derived from the joints (``core.skeleton.tails``).
+SAMPLE_FORMAT_VERSION = 4
 
 
 @dataclass(frozen=True)
