@@ -1,4 +1,4 @@
-"""Binary glTF files with skins, written byte by byte (no Blender)."""
+"""glTF files with skins (binary .glb, or .gltf with the buffer embedded), written byte by byte (no Blender)."""
 
 import base64
 import json

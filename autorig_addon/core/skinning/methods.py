@@ -38,7 +38,7 @@ SKIN_METHODS = (GEOMETRIC,) + NETWORK_NAMES + (ENSEMBLE,)
 #: (:mod:`.learned.ensemble`) is nearer the artists' weights on the held-out
 #: training characters (L1 0.4082 against 0.4199) and on the validation
 #: families with smooth weights, but on the validation set as a whole it is
-#: behind (mean L1 0.581 against 0.574, precision 0.695 against 0.720): its
+#: behind (mean L1 0.581 against 0.560, precision 0.697 against 0.725): its
 #: wider blends cost most where artists put every vertex on one bone
 #: (Kenney's minis, the dungeon monsters; docs/skinning.md). A default is
 #: not changed for a method that the validation set measures worse.

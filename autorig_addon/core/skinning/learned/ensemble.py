@@ -17,10 +17,12 @@ characters).
 
 On the 91 validation characters (``eval skin --method ensemble``,
 2026-11-26) it is nearer the artists on the families with smooth weights
-(Quaternius' monsters L1 0.365 against HeterSkinNet's 0.406, their animated
+(Quaternius' monsters L1 0.363 against HeterSkinNet's 0.404, their animated
 characters 0.151 against 0.167) and farther where every vertex is on one
-bone (Kenney's minis 1.011 against 0.961, the dungeon monsters 1.003
-against 0.923), so its mean L1 is behind (0.581 against 0.574) and
+bone (Kenney's minis 0.971 against 0.814, the dungeon monsters 1.003
+against 0.923; on the minis also because SkinningNet does worse than
+HeterSkinNet along their derived bones, ``core.skeleton.tails``), so its
+mean L1 is behind (0.581 against 0.560) and
 HeterSkinNet stays the default (``..methods.DEFAULT_SKIN_METHOD``).
 """
 
