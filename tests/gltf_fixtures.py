@@ -6,6 +6,10 @@ import json
 import numpy as np
 
 from autorig_addon.core.io.glb import GLB_BINARY_CHUNK, GLB_CHUNK_HEADER, GLB_HEADER, GLB_JSON_CHUNK, GLB_MAGIC
+from geometry_fixtures import box_mesh
+
+#: Grid spacing of the boxes of write_box_character_gltf, scene units.
+BOX_SPACING = 0.03
 
 
 def write_glb(path, document: dict, binary: bytes) -> None:
@@ -69,32 +73,6 @@ def write_rig_glb(path, names, parents, extras=None) -> None:
     write_glb(path, *skinned_document(names, parents, joints, weights, extras))
 
 
-def box_surface(low, high, segments: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices and outward triangles of the box ``low``..``high``, each face
-    cut into ``segments`` x ``segments`` squares."""
-    low, high = np.asarray(low, float), np.asarray(high, float)
-    vertices, triangles = [], []
-    for axis in range(3):
-        u, v = [other for other in range(3) if other != axis]
-        for side, corner in enumerate((low, high)):
-            start = len(vertices)
-            for i in range(segments + 1):
-                for j in range(segments + 1):
-                    point = np.empty(3)
-                    point[axis] = corner[axis]
-                    point[u] = low[u] + (high[u] - low[u]) * i / segments
-                    point[v] = low[v] + (high[v] - low[v]) * j / segments
-                    vertices.append(point)
-            for i in range(segments):
-                for j in range(segments):
-                    a = start + i * (segments + 1) + j
-                    b, c, d = a + segments + 1, a + 1, a + segments + 2
-                    # Wound so the normal leaves the box on both sides of each axis.
-                    flip = (side == 1) == (axis == 1)
-                    triangles += [(a, c, b), (c, d, b)] if flip else [(a, b, c), (c, b, d)]
-    return np.array(vertices), np.array(triangles)
-
-
 def _y_up(points) -> np.ndarray:
     """Blender's Z-up coordinates as glTF's Y-up ones."""
     points = np.asarray(points, float)
@@ -114,10 +92,10 @@ def write_box_character_gltf(path, bones) -> None:
     for joint, (_, _, _, extent) in enumerate(bones):
         if extent is None:
             continue
-        vertices, faces = box_surface(*extent)
-        triangles.append(faces + sum(len(block) for block in positions))
-        positions.append(vertices)
-        owners += [joint] * len(vertices)
+        box = box_mesh(*extent, BOX_SPACING)
+        triangles.append(box.triangles + sum(len(block) for block in positions))
+        positions.append(box.vertices)
+        owners += [joint] * box.vertex_count
     positions = _y_up(np.vstack(positions)).astype(np.float32)
     indices = np.vstack(triangles).astype(np.uint16).ravel()
     joint_ids = np.zeros((len(positions), 4), np.uint8)

@@ -391,3 +391,60 @@ def test_auto_rig_replacing_a_posed_rig_takes_the_swords_where_they_are_at_rest(
         assert tuple(pose_bone.rotation_quaternion) == (1.0, 0.0, 0.0, 0.0)
     np.testing.assert_allclose(evaluated_world_vertices(sword), sword_at_rest, atol=1e-5)
     assert_bound_wholly_to(sword, armature, "hand.R")
+
+
+def add_mirrored_swords():
+    """The sword in the right hand and its mirror image in the left, objects of their own, no rig."""
+    sword = add_sword()
+    blade = box_mesh(SWORD_LOW, SWORD_HIGH, 0.02)
+    offhand = mesh_object("Sword_Offhand", blade.vertices * [-1.0, 1.0, 1.0], blade.triangles[:, ::-1])
+    bpy.context.view_layer.update()
+    return sword, offhand
+
+
+def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(clean_scene, capfd):
+    """A mirrored pair has a twin each, so props.py kept them as body: the
+    hands' bones ran along the blades (5 mm from them) and each blade was
+    skinned over the hand and the forearm. Thin, sticking out and touching
+    the body only where the landmark network puts its wrists, they are now
+    held props (core.rigging.held_at_hands)."""
+    names_alone, _ = bones_of_the_biped_alone()
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    select_only([body, sword, offhand], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert [bone.name for bone in armature.data.bones] == names_alone
+    out = capfd.readouterr().out
+    for obj, bone in ((sword, "hand.R"), (offhand, "hand.L")):
+        assert f"'{obj.name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
+        assert_no_bone_near_the_blade(armature, obj)
+    assert_bound_wholly_to(sword, armature, "hand.R")
+    assert_wholly_on(offhand, armature, "hand.L")
+
+
+def test_thin_twins_touching_the_head_are_skinned_with_the_body(clean_scene, capfd):
+    """Two flat ears standing on the head (a rabbit's, 17 cm tall, 2 cm
+    thick), mirror images, thin and sticking out as the swords are: they
+    touch the body far from its wrists, so they stay part of the body and are
+    skinned with it."""
+    body = add_biped()
+    ears = []
+    for name, side in (("Ear.L", 1.0), ("Ear.R", -1.0)):
+        ear = box_mesh((0.03, -0.01, 0.98), (0.07, 0.01, 1.15), 0.02)
+        triangles = ear.triangles if side > 0 else ear.triangles[:, ::-1]
+        ears.append(mesh_object(name, ear.vertices * [side, 1.0, 1.0], triangles))
+    bpy.context.view_layer.update()
+    select_only([body, *ears], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert "held" not in capfd.readouterr().out
+    skeleton = convert.read_skeleton(armature)
+    for ear in ears:
+        weights = group_weights(ear, skeleton.names)
+        np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
+        assert weights[:, skeleton.names.index("head")].mean() > 0.5

@@ -39,6 +39,7 @@ from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
+from ...core.rigging.held_at_hands import props_held_at_hands
 from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
@@ -319,6 +320,8 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carrie
     told = carried_props(mesh, on_bones) if on_bones else ()
     props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
                   if prop.object_index not in {known.object_index for known in told}) + told
+    # Twins or props across the mirror plane: held when they touch the body at its hands.
+    props += props_held_at_hands(mesh, parts.left_out, [prop.object_index for prop in props if prop.piece is None])
     dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:

@@ -35,7 +35,8 @@ out of the skeleton would be worse than giving a sword bones. Where the
 other plane mirrors the body about as well (a round body; not
 :data:`.symmetry.CLEARLY_BETTER`), a prop must lack a twin across both. A
 prop on the mirror plane (a staff held centred in both hands) or a pair of
-them (a sword in each hand, mirrored) has a twin and stays part of the body.
+them (a sword in each hand, mirrored) has a twin and is not told here:
+:mod:`.held_at_hands` tells the thin ones by where they touch the body.
 
 A loose piece joined into a larger object (a sword joined into the body's
 mesh, Ctrl+J) is told the same way, piece by piece, but only when it is

@@ -1,0 +1,201 @@
+"""Thin props held at the hands, twin or not: a sword in each hand, a staff held in both.
+
+:mod:`.props` tells a prop by its lacking a twin across the body's mirror
+plane, so a mirrored pair (a sword in each hand) or a prop lying across the
+plane (a staff held centred) stays part of the body: the skeleton then runs
+the hand bones along the blades and the skin bends them. The shape alone
+does not tell such a pair from the body's own twinned parts (KayKit's arms
+and legs are objects of their own, wings and ears are thin and stick out);
+where they touch the body does. Here:
+
+1. **candidates** (:func:`thin_candidates`): objects that are small (under
+   :data:`.props.PROP_AREA_SHARE` of the rest's area), **thin** (their
+   smallest extent along their principal axes under :data:`THIN_RATIO` of
+   their largest: a blade, a staff, a shield, a bow; not an arm, a leg, a
+   hand or a head), sticking out of the rest (over :data:`.props.OUT_SHARE`
+   of their area farther than :data:`.props.NEAR_SHARE` of its largest
+   side) and touching it (within that distance somewhere);
+2. **held at the hands** (:func:`held_at_hands`): the landmark network reads
+   the body without the candidates; a candidate is held when most of where
+   it touches the body (:data:`AT_HAND_SHARE`) lies within
+   :data:`HAND_REACH` of the body's largest side of a wrist, on a body read
+   surely as a biped. Wings and ears touch the back and the head; a cape
+   the neck.
+
+The caller binds what is held wholly to the bone nearest its grip, the
+mean of where it touches the body near the wrist that holds most of it (a
+staff held in both hands goes to the hand holding more of it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..dataset.normalise import apply_transform
+from ..errors import InputError
+from ..geometry.bounding_box import largest_side
+from ..geometry.closest_point import TriangleMeshQuery
+from ..geometry.normals import triangle_double_areas
+from ..types import Mesh
+from .nearest_character import surface_points
+from .networks.landmarks import BODY_KINDS
+from .predict import predict_votes, sure_standard_kind
+from .props import NEAR_SHARE, OUT_SHARE, PROP_AREA_SHARE, SAMPLES_PER_OBJECT, Prop
+
+#: Thin: the smallest of an object's extents along its principal axes is
+#: under this share of the largest (a blade 1.6 cm square and 53 cm long:
+#: 0.03; a round shield: about 0.1; an arm, a hand, a boot: 0.25 and more).
+THIN_RATIO = 0.2
+#: A point touching the body is at a hand within this share of the body's
+#: largest side of a wrist (the hand head): about a hand's length.
+HAND_REACH = 0.1
+#: A candidate is held when at least this share of where it touches the body lies at a hand.
+AT_HAND_SHARE = 0.5
+#: The wrists the landmark network reads, left and right (core.skeleton.key_joints).
+WRISTS = ("wrist.L", "wrist.R")
+#: Only a body read surely as a biped has hands to hold with.
+HOLDING_KIND = BODY_KINDS[0]
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """A thin object of the character that may be held (:func:`thin_candidates`).
+
+    Attributes
+    ----------
+    object_index : int, the object in the mesh's ``object_names``
+    touching : (k,) x 3 float array, world space: its surface points within :data:`.props.NEAR_SHARE`
+        of the body's largest side of the body's surface, k >= 1
+    gap : float, the smallest distance from those points to the body's surface, scene units
+    """
+
+    object_index: int
+    touching: np.ndarray
+    gap: float
+
+
+def thinness(points: np.ndarray) -> float:
+    """The smallest extent of ``points`` along their principal axes over the largest (0 for a flat or
+    straight set, 1 for a cube's corners); 1 for fewer than two distinct points."""
+    centred = np.asarray(points, dtype=np.float64) - np.mean(points, axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    extents = np.ptp(centred @ axes.T, axis=0)
+    return float(extents.min() / extents.max()) if extents.max() > 0 else 1.0
+
+
+def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
+    """The objects of ``mesh`` that may be props held at the hands (module docstring, step 1).
+
+    Parameters
+    ----------
+    mesh : Mesh, world space, one or more objects
+    left_out : (n,) bool array or None, vertices that are not the character (a ground plane, specks):
+        an object with any of them is never a candidate, and they are not the body
+    told : indices of objects already told as props (:mod:`.props`): neither candidates nor the body
+
+    Returns
+    -------
+    tuple of Candidate in the objects' order; empty for a mesh of one object
+    """
+    objects = len(mesh.object_names)
+    if objects < 2:
+        return ()
+    vertices = mesh.vertices
+    kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
+    triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)]
+    triangles = triangles[triangle_double_areas(vertices, triangles) > 0]
+    owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
+    area = 0.5 * np.bincount(owner, weights=triangle_double_areas(vertices, triangles), minlength=objects)
+    told = set(int(index) for index in told)
+    thin = {}
+    for index in range(objects):
+        whole = kept[mesh.object_slice(index)].all()
+        if index in told or not whole or area[index] <= 0:
+            continue
+        if area[index] >= PROP_AREA_SHARE * (area.sum() - area[index] - sum(area[j] for j in told)):
+            continue
+        points = surface_points(vertices, triangles[owner == index], SAMPLES_PER_OBJECT)
+        if thinness(points) < THIN_RATIO:
+            thin[index] = points
+    body = triangles[~np.isin(owner, list(told | set(thin)))]
+    if not thin or not len(body):
+        return ()
+    near = NEAR_SHARE * largest_side(vertices[np.unique(body)])
+    query = TriangleMeshQuery(vertices, body)
+    candidates = []
+    for index, points in sorted(thin.items()):
+        distances = query.closest(points).distances
+        touching = distances <= near
+        if touching.any() and np.mean(~touching) > OUT_SHARE:
+            candidates.append(Candidate(index, points[touching], float(distances.min())))
+    return tuple(candidates)
+
+
+def held_at_hands(candidates, wrists: dict, body_size: float) -> tuple[Prop, ...]:
+    """The candidates held at the hands (module docstring, step 2), as held props.
+
+    Parameters
+    ----------
+    candidates : Candidates (:func:`thin_candidates`)
+    wrists : dict mapping ``wrist.L`` and ``wrist.R`` (those found) to (3,) world points
+    body_size : float, the largest side of the body without the candidates, scene units
+
+    Returns
+    -------
+    tuple of Prop (``held`` set, ``grip`` where it touches the body near the wrist holding most of it)
+    """
+    if not wrists:
+        return ()
+    names = sorted(wrists)
+    points = np.array([wrists[name] for name in names], dtype=np.float64)
+    reach = HAND_REACH * body_size
+    held = []
+    for candidate in candidates:
+        distances = np.linalg.norm(candidate.touching[:, None, :] - points[None, :, :], axis=2)
+        nearest = distances.argmin(axis=1)
+        at_hand = distances[np.arange(len(nearest)), nearest] <= reach
+        if np.mean(at_hand) < AT_HAND_SHARE:
+            continue
+        holding = np.bincount(nearest[at_hand], minlength=len(names)).argmax()
+        grip = candidate.touching[at_hand & (nearest == holding)].mean(axis=0)
+        held.append(Prop(candidate.object_index, grip, candidate.gap, True))
+    return tuple(held)
+
+
+def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Prop, ...]:
+    """The thin objects of ``mesh`` held at the hands (both steps of the module docstring).
+
+    The landmark network reads the body (``mesh`` without ``left_out``, the
+    ``told`` props and the candidates) only when there is a candidate; a
+    body it cannot read (too few faces), or does not read surely as a biped,
+    holds nothing.
+
+    Parameters
+    ----------
+    mesh : Mesh, world space, one or more objects
+    left_out : (n,) bool array or None, vertices that are not the character
+    told : indices of objects already told as props
+
+    Returns
+    -------
+    tuple of Prop, in the objects' order
+    """
+    candidates = thin_candidates(mesh, left_out, told)
+    if not candidates:
+        return ()
+    rows = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
+    for index in {candidate.object_index for candidate in candidates} | set(int(index) for index in told):
+        rows[mesh.object_slice(index)] = False
+    body = mesh.subset(rows)
+    try:
+        votes = predict_votes(body)
+    except InputError:
+        return ()
+    if sure_standard_kind(votes.landmarks) != HOLDING_KIND:
+        return ()
+    points = votes.landmarks.points_for(HOLDING_KIND)
+    to_mesh = np.linalg.inv(votes.transform)
+    wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
+    return held_at_hands(candidates, wrists, largest_side(body.vertices))

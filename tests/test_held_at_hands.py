@@ -1,0 +1,82 @@
+"""Thin props held at the hands (autorig_addon.core.rigging.held_at_hands):
+how thin a shape is, which objects may be held, and which are."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.rigging.held_at_hands import (
+    AT_HAND_SHARE,
+    HAND_REACH,
+    THIN_RATIO,
+    Candidate,
+    held_at_hands,
+    thin_candidates,
+    thinness,
+)
+from autorig_addon.core.rigging.nearest_character import surface_points
+from autorig_addon.core.types import Mesh
+from geometry_fixtures import box_mesh
+
+
+def box_points(low, high) -> np.ndarray:
+    box = box_mesh(low, high, 0.02)
+    return surface_points(box.vertices, box.triangles, 2048)
+
+
+def test_thinness_is_the_smallest_principal_extent_over_the_largest():
+    assert thinness(box_points((0, 0, 0), (1.0, 0.1, 0.05))) == pytest.approx(0.05, abs=0.005)
+    # A cube has no principal axes of its own: along any, its extents lie between its side and sqrt(3) times it.
+    assert thinness(box_points((0, 0, 0), (0.3, 0.3, 0.3))) > 1 / np.sqrt(3) - 0.01
+    # Turned 45 degrees about z, a blade is as thin: the axes are its own.
+    turn = np.array([[np.sqrt(0.5), -np.sqrt(0.5), 0], [np.sqrt(0.5), np.sqrt(0.5), 0], [0, 0, 1.0]])
+    assert thinness(box_points((0, 0, 0), (1.0, 0.1, 0.05)) @ turn.T) == pytest.approx(0.05, abs=0.005)
+    assert thinness(np.zeros((4, 3))) == 1.0
+
+
+def body_with(*others: Mesh) -> Mesh:
+    """A 1 x 0.4 x 2 block (the body) and ``others``, objects of their own."""
+    body = box_mesh((-0.5, -0.2, 0.0), (0.5, 0.2, 2.0), 0.1)
+    parts = [Mesh(body.vertices, body.triangles, object_names=("Body",))]
+    parts += [Mesh(other.vertices, other.triangles, object_names=(f"Part{k}",)) for k, other in enumerate(others)]
+    return Mesh.concatenate(parts)
+
+
+def test_thin_objects_sticking_out_and_touching_are_candidates():
+    stick = box_mesh((0.5, -0.02, 1.0), (1.3, 0.02, 1.04), 0.02)  # touches the side, 0.8 out
+    block = box_mesh((0.5, -0.1, 1.5), (0.7, 0.1, 1.7), 0.02)  # touches, sticks out, not thin
+    flat = box_mesh((-0.3, 0.2, 0.5), (0.3, 0.23, 1.5), 0.02)  # thin, lying on the body's front
+    apart = box_mesh((2.0, -0.02, 1.0), (2.8, 0.02, 1.04), 0.02)  # thin, far from the body
+    mesh = body_with(stick, block, flat, apart)
+    (candidate,) = thin_candidates(mesh)
+    assert candidate.object_index == 1 and candidate.gap < 1e-6
+    # Where it touches: its end at the body's side (within 3 % of the body's largest side, 2.0).
+    assert np.all(candidate.touching[:, 0] <= 0.5 + 0.06 + 1e-9)
+    assert thinness(surface_points(stick.vertices, stick.triangles, 512)) < THIN_RATIO
+    # Told as a prop already (or left out), it is no candidate.
+    assert thin_candidates(mesh, told=[1]) == ()
+    left_out = np.zeros(mesh.vertex_count, dtype=bool)
+    left_out[mesh.object_slice(1)] = True
+    assert thin_candidates(mesh, left_out) == ()
+
+
+def test_a_candidate_touching_at_a_wrist_is_held_gripped_there():
+    wrists = {"wrist.L": np.array([0.5, 0.0, 1.0]), "wrist.R": np.array([-0.5, 0.0, 1.0])}
+    size = 2.0
+    reach = HAND_REACH * size
+    rng = np.random.default_rng(0)
+    at_right = wrists["wrist.R"] + rng.uniform(-0.5, 0.5, (30, 3)) * reach
+    at_head = np.array([0.0, 0.0, 1.9]) + rng.uniform(-0.05, 0.05, (30, 3))
+    sword = Candidate(3, at_right, 0.0)
+    ear = Candidate(4, at_head, 0.0)
+    # A staff held in both hands, more of it in the left: gripped at the left.
+    at_left = wrists["wrist.L"] + rng.uniform(-0.5, 0.5, (40, 3)) * reach
+    staff = Candidate(5, np.vstack([at_left, at_right[:20]]), 0.0)
+    props = held_at_hands([sword, ear, staff], wrists, size)
+    assert [prop.object_index for prop in props] == [3, 5]
+    assert all(prop.held for prop in props)
+    np.testing.assert_allclose(props[0].grip, at_right.mean(axis=0))
+    np.testing.assert_allclose(props[1].grip, at_left.mean(axis=0))
+    # Touching mostly elsewhere: a wing along the arm and the back, a fifth of it at the hand.
+    wing = Candidate(6, np.vstack([at_right[:6], at_head[:24]]), 0.0)
+    assert 6 / 30 < AT_HAND_SHARE and held_at_hands([wing], wrists, size) == ()
+    assert held_at_hands([sword], {}, size) == ()
