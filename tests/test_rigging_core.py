@@ -21,6 +21,7 @@ from autorig_addon.core.rigging.facing import front_untold_note
 from autorig_addon.core.rigging.joint_features import SolidDepth, solid_depth
 from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from autorig_addon.core.skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX, mirror_name
+from autorig_addon.core.skeleton.posing import axis_angle_matrices, posed_vertices
 from autorig_addon.core.types import Mesh, Skeleton
 from autorig_addon.training.rigging.training_set import joint_targets
 from geometry_fixtures import box_mesh, cylinder, triangle_and_flat_triangles
@@ -744,6 +745,38 @@ def test_a_biped_facing_plus_y_is_turned_so_its_left_bones_are_on_its_left():
         assert (skeleton.joints[names[role + LEFT_SUFFIX]] - skeleton.joints[names[role + RIGHT_SUFFIX]]) @ left > 0
     # The toes point where the character faces.
     forward = rotation @ [0.0, -1.0, 0.0]
+    assert (skeleton.tails[names["toe.L"]] - skeleton.joints[names["foot.L"]]) @ forward > 0
+
+
+def biped_with_left_arm_turned(degrees: float) -> Mesh:
+    """The procedural biped posed by its own weights with its left arm
+    turned ``degrees`` about the front-back axis at the shoulder (in its
+    frontal plane), taken as a rest shape."""
+    character = generate_character(BIPED_SEED, "biped")
+    deform = character.skeleton.deform_subset()
+    columns = [character.weights.bone_names.index(name) for name in deform.names]
+    rotations = np.tile(np.eye(3), (1, deform.bone_count, 1, 1))
+    rotations[0, deform.names.index("upper_arm.L")] = axis_angle_matrices(np.array([[0.0, 1.0, 0.0]]),
+                                                                          np.radians([degrees]))[0]
+    posed = posed_vertices(character.mesh.vertices, character.weights.matrix[:, columns], character.skeleton,
+                           rotations)[0]
+    return Mesh(posed, character.mesh.triangles)
+
+
+@pytest.mark.parametrize("degrees", [40.0, 90.0])
+def test_a_biped_with_one_arm_turned_keeps_its_left_on_its_left(degrees):
+    """With one arm turned in its frontal plane the biped mirrors better
+    front to back (its arms stay in that plane) than left to right: that
+    plane was its mirror plane and it was rigged turned a quarter, .L on its
+    right. Its feet, apart across the other plane, now tell."""
+    votes = predict.predict_votes(biped_with_left_arm_turned(degrees))
+    assert any(note.startswith("The shape mirrors best front to back, but its feet") for note in votes.notes)
+    assert not any("faces +-X" in note or "turned half a turn" in note for note in votes.notes)
+    skeleton = predict.skeleton_from_votes(votes, template="biped")
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    for role in ("upper_arm", "thigh", "foot"):
+        assert skeleton.joints[names[role + LEFT_SUFFIX], 0] > 0 > skeleton.joints[names[role + RIGHT_SUFFIX], 0]
+    forward = np.array([0.0, -1.0, 0.0])
     assert (skeleton.tails[names["toe.L"]] - skeleton.joints[names["foot.L"]]) @ forward > 0
 
 

@@ -95,6 +95,23 @@ FEET_BALANCE = 0.3
 #: mirror plane: the two faces of a thin plate, a fish's fins, are not feet
 #: (every cached humanoid and quadruped whose feet the cue finds stands wider).
 FEET_HALF_WIDTH = 0.06
+#: An upright mirror plane that runs through the feet is the body's front-back
+#: plane when the upright plane across it splits them: at least this share of
+#: the lowest band lies on the plane's midline (the band's own centre, so
+#: that an arm raised on one side does not move it) ...
+FEET_STRADDLED = 0.1
+#: ... at most this share on the midline of the plane across it ...
+FEET_SPLIT = 0.05
+#: ... and the plane across mirrors the whole shape within this factor of the
+#: first. A biped with one arm turned 30 to 90 degrees in its frontal plane
+#: mirrors better front to back (its arms stay in that plane; error ratios
+#: 1.8 to 2.7): with that plane taken, it was rigged turned a quarter, its
+#: .L bones on its right. None of the 396 cached characters with an upright
+#: plane meets all three as they stand (the nearest, a fish: ratio 17.8;
+#: ``scripts/check_orientation.py as-is`` keeps every one).
+FEET_ACROSS_ERROR_RATIO = 5.0
+#: A quarter turn about +Z: the upright plane across a frame's mirror plane.
+QUARTER_TURN = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
 def best_mirror_plane(points: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -314,6 +331,7 @@ def stand_upright(points: np.ndarray, triangles: np.ndarray, landmarks_of: Calla
     if frame is None:
         rotation = np.eye(3)
         return Stance(rotation, landmarks_of(rotation))
+    frame, feet_notes = _plane_between_the_feet(points, triangles, frame)
     framed = points @ frame.T
     probabilities = up_probabilities(framed, triangles)
     on_its_side = abs(frame[0, 2]) >= np.cos(np.radians(45.0))
@@ -357,7 +375,40 @@ def stand_upright(points: np.ndarray, triangles: np.ndarray, landmarks_of: Calla
         raise InputError("The character seems to lie on its side (its mirror plane is horizontal), and no way of "
                          "standing it up reads as a biped or quadruped: stand it upright along +Z, facing -Y, and "
                          "predict again.")
-    return Stance(frame, landmarks, tuple(_facing_notes(frame)))
+    return Stance(frame, landmarks, (*feet_notes, *_facing_notes(frame)))
+
+
+def _plane_between_the_feet(points: np.ndarray, triangles: np.ndarray, frame: np.ndarray) -> tuple[np.ndarray, list]:
+    """``frame``, or the upright frame across it when its mirror plane runs
+    through the feet and the plane across splits them (:data:`FEET_STRADDLED`,
+    :data:`FEET_SPLIT`, :data:`FEET_ACROSS_ERROR_RATIO`), with a note then."""
+    if abs(frame[0, 2]) >= np.cos(np.radians(45.0)):
+        return frame, []  # the plane lies flat: no feet to tell by
+    across = QUARTER_TURN @ frame
+    normal = across[0]
+    if normal[0] < -1e-12 or (abs(normal[0]) <= 1e-12 and normal[1] < 0):
+        across = np.diag([-1.0, -1.0, 1.0]) @ across  # the same plane, signed as mirror_frame signs it
+    if (_feet_midline(points @ frame.T, triangles) < FEET_STRADDLED
+            or _feet_midline(points @ across.T, triangles) > FEET_SPLIT):
+        return frame, []
+    tree = cKDTree(points)
+    if mirror_error_across(points, across[0], tree) > FEET_ACROSS_ERROR_RATIO * mirror_error_across(points, frame[0],
+                                                                                                     tree):
+        return frame, []
+    return across, ["The shape mirrors best front to back, but its feet stand apart across the other upright plane, "
+                    "so that one was taken as its mirror plane (an arm raised on one side, say)."]
+
+
+def _feet_midline(framed: np.ndarray, triangles: np.ndarray) -> float:
+    """The share of the lowest height band's area (:data:`.up_features.UP_BANDS`)
+    within :data:`.up_features.MIDLINE_SHARE` of its half width of the band's
+    own centre along x."""
+    surface, shares = area_centroids(framed, triangles)
+    heights = surface[:, 2] - surface[:, 2].min()
+    band = heights < heights.max() / UP_BANDS
+    x = surface[band, 0] - 0.5 * (surface[band, 0].min() + surface[band, 0].max())
+    weights = shares[band] / max(shares[band].sum(), 1e-300)
+    return float(weights[np.abs(x) < MIDLINE_SHARE * np.abs(x).max()].sum())
 
 
 def _stands_on_its_head(framed: np.ndarray, triangles: np.ndarray) -> bool:
