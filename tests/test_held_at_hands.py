@@ -4,12 +4,14 @@ how thin a shape is, which objects may be held, and which are."""
 import numpy as np
 import pytest
 
+from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging.held_at_hands import (
     AT_HAND_SHARE,
     HAND_REACH,
     THIN_RATIO,
     Candidate,
     held_at_hands,
+    props_held_at_hands,
     thin_candidates,
     thinness,
 )
@@ -59,24 +61,54 @@ def test_thin_objects_sticking_out_and_touching_are_candidates():
     assert thin_candidates(mesh, left_out) == ()
 
 
-def test_a_candidate_touching_at_a_wrist_is_held_gripped_there():
+def test_a_candidate_touching_at_a_wrist_and_reaching_out_of_the_hand_is_held_gripped_there():
     wrists = {"wrist.L": np.array([0.5, 0.0, 1.0]), "wrist.R": np.array([-0.5, 0.0, 1.0])}
     size = 2.0
     reach = HAND_REACH * size
     rng = np.random.default_rng(0)
     at_right = wrists["wrist.R"] + rng.uniform(-0.5, 0.5, (30, 3)) * reach
-    at_head = np.array([0.0, 0.0, 1.9]) + rng.uniform(-0.05, 0.05, (30, 3))
-    sword = Candidate(3, at_right, 0.0)
-    ear = Candidate(4, at_head, 0.0)
-    # A staff held in both hands, more of it in the left: gripped at the left.
     at_left = wrists["wrist.L"] + rng.uniform(-0.5, 0.5, (40, 3)) * reach
-    staff = Candidate(5, np.vstack([at_left, at_right[:20]]), 0.0)
+    at_head = np.array([0.0, 0.0, 1.9]) + rng.uniform(-0.05, 0.05, (30, 3))
+    # A blade from the right hand 0.8 forward: most of it beyond the hand.
+    blade = wrists["wrist.R"] + np.linspace(0.0, 0.8, 100)[:, None] * [0.0, -1.0, 0.0]
+    sword = Candidate(3, np.vstack([at_right, blade]), at_right, 0.0)
+    ear = Candidate(4, at_head, at_head, 0.0)
+    # A staff held in both hands, more of it in the left: gripped at the left.
+    shaft = np.linspace(wrists["wrist.R"], wrists["wrist.L"], 100) + [0.0, -0.05, 0.0]
+    staff = Candidate(5, shaft, np.vstack([at_left, at_right[:20]]), 0.0)
     props = held_at_hands([sword, ear, staff], wrists, size)
     assert [prop.object_index for prop in props] == [3, 5]
     assert all(prop.held for prop in props)
     np.testing.assert_allclose(props[0].grip, at_right.mean(axis=0))
     np.testing.assert_allclose(props[1].grip, at_left.mean(axis=0))
     # Touching mostly elsewhere: a wing along the arm and the back, a fifth of it at the hand.
-    wing = Candidate(6, np.vstack([at_right[:6], at_head[:24]]), 0.0)
+    wing = Candidate(6, np.vstack([blade, at_head]), np.vstack([at_right[:6], at_head[:24]]), 0.0)
     assert 6 / 30 < AT_HAND_SHARE and held_at_hands([wing], wrists, size) == ()
+    # A glove, or both hands in one object: at the wrists, but nothing of it beyond a hand's reach.
+    hands = Candidate(7, np.vstack([at_right, at_left]), np.vstack([at_right, at_left]), 0.0)
+    assert held_at_hands([hands], wrists, size) == ()
     assert held_at_hands([sword], {}, size) == ()
+
+
+def test_the_procedural_bipeds_mirrored_swords_are_held_and_its_ears_are_not():
+    """The biped (seed 0, 0.94 tall, right hand near x -0.28, z 0.57) with a
+    sword through each hand, mirror images, and two flat ears on its head:
+    all four are thin candidates; the swords touch it at the wrists the
+    landmark network reads, the ears at the head."""
+    character = generate_character(0, "biped")
+    body = Mesh(character.mesh.vertices, character.mesh.triangles, object_names=("Biped",))
+    sword = box_mesh((-0.286, -0.5, 0.565), (-0.27, 0.03, 0.581), 0.02)
+    ear = box_mesh((0.03, -0.01, 0.98), (0.07, 0.01, 1.15), 0.02)
+    parts = [body]
+    for name, box in (("Sword", sword), ("Sword.L", sword), ("Ear.L", ear), ("Ear.R", ear)):
+        mirrored = name in ("Sword.L", "Ear.R")
+        vertices = box.vertices * [-1.0, 1.0, 1.0] if mirrored else box.vertices
+        triangles = box.triangles[:, ::-1] if mirrored else box.triangles
+        parts.append(Mesh(vertices, triangles, object_names=(name,)))
+    mesh = Mesh.concatenate(parts)
+    assert [candidate.object_index for candidate in thin_candidates(mesh)] == [1, 2, 3, 4]
+    props = props_held_at_hands(mesh)
+    assert [prop.object_index for prop in props] == [1, 2]
+    # Gripped where the blades pass through the hands.
+    np.testing.assert_allclose(props[0].grip, [-0.278, -0.01, 0.573], atol=0.03)
+    np.testing.assert_allclose(props[1].grip, [0.278, -0.01, 0.573], atol=0.03)

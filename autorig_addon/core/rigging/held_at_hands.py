@@ -19,8 +19,11 @@ where they touch the body does. Here:
    the body without the candidates; a candidate is held when most of where
    it touches the body (:data:`AT_HAND_SHARE`) lies within
    :data:`HAND_REACH` of the body's largest side of a wrist, on a body read
-   surely as a biped. Wings and ears touch the back and the head; a cape
-   the neck.
+   surely as a biped, and most of it reaches beyond that
+   (:data:`BEYOND_HAND_SHARE`). Wings and ears touch the back and the head;
+   a cape the neck; a hand, a glove or a gauntlet of its own (or both hands
+   in one object, which is thin across the two) lies within a hand's reach
+   of its wrist.
 
 The caller binds what is held wholly to the bone nearest its grip, the
 mean of where it touches the body near the wrist that holds most of it (a
@@ -51,8 +54,12 @@ THIN_RATIO = 0.2
 #: A point touching the body is at a hand within this share of the body's
 #: largest side of a wrist (the hand head): about a hand's length.
 HAND_REACH = 0.1
-#: A candidate is held when at least this share of where it touches the body lies at a hand.
+#: A candidate is held when at least this share of where it touches the body lies at a hand ...
 AT_HAND_SHARE = 0.5
+#: ... and at least this share of its surface lies farther than :data:`HAND_REACH`
+#: from that wrist: a blade, a staff or a shield reaches out of the hand; a
+#: hand, a glove or a short claw does not (they stay the body's).
+BEYOND_HAND_SHARE = 0.5
 #: The wrists the landmark network reads, left and right (core.skeleton.key_joints).
 WRISTS = ("wrist.L", "wrist.R")
 #: Only a body read surely as a biped has hands to hold with.
@@ -66,12 +73,14 @@ class Candidate:
     Attributes
     ----------
     object_index : int, the object in the mesh's ``object_names``
-    touching : (k,) x 3 float array, world space: its surface points within :data:`.props.NEAR_SHARE`
+    surface : (s, 3) float array, world space: points drawn on its surface
+    touching : (k, 3) float array, world space: those within :data:`.props.NEAR_SHARE`
         of the body's largest side of the body's surface, k >= 1
     gap : float, the smallest distance from those points to the body's surface, scene units
     """
 
     object_index: int
+    surface: np.ndarray
     touching: np.ndarray
     gap: float
 
@@ -129,7 +138,7 @@ def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> 
         distances = query.closest(points).distances
         touching = distances <= near
         if touching.any() and np.mean(~touching) > OUT_SHARE:
-            candidates.append(Candidate(index, points[touching], float(distances.min())))
+            candidates.append(Candidate(index, points, points[touching], float(distances.min())))
     return tuple(candidates)
 
 
@@ -159,6 +168,9 @@ def held_at_hands(candidates, wrists: dict, body_size: float) -> tuple[Prop, ...
         if np.mean(at_hand) < AT_HAND_SHARE:
             continue
         holding = np.bincount(nearest[at_hand], minlength=len(names)).argmax()
+        beyond = np.linalg.norm(candidate.surface - points[holding], axis=1) > reach
+        if np.mean(beyond) < BEYOND_HAND_SHARE:
+            continue
         grip = candidate.touching[at_hand & (nearest == holding)].mean(axis=0)
         held.append(Prop(candidate.object_index, grip, candidate.gap, True))
     return tuple(held)

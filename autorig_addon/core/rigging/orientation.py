@@ -18,7 +18,10 @@ every direction about up:
    through its centre that mirrors it best (:func:`best_mirror_plane`:
    among the shape's principal axes and the mesh's own, refined) has the
    left-right axis as its normal, so up is one of the four directions
-   across it.
+   across it. An upright plane the feet straddle gives way to the upright
+   plane across it when that one splits them (:func:`_plane_between_the_feet`:
+   a biped with one arm turned in its frontal plane mirrors better front to
+   back).
 2. **Up along that plane**, of those four: the one the :data:`UP_CUES`
    score highest (:func:`up_score`). The cues were measured on the
    cached development characters turned every way (docs/bad_input.md).
@@ -102,8 +105,8 @@ FEET_HALF_WIDTH = 0.06
 FEET_STRADDLED = 0.1
 #: ... at most this share on the midline of the plane across it ...
 FEET_SPLIT = 0.05
-#: ... and the plane across mirrors the whole shape within this factor of the
-#: first. A biped with one arm turned 30 to 90 degrees in its frontal plane
+#: ... and the plane across mirrors the whole shape at most this many times
+#: worse than the first. A biped with one arm turned 30 to 90 degrees in its frontal plane
 #: mirrors better front to back (its arms stay in that plane; error ratios
 #: 1.8 to 2.7): with that plane taken, it was rigged turned a quarter, its
 #: .L bones on its right. None of the 396 cached characters with an upright
@@ -304,8 +307,10 @@ def stand_upright(points: np.ndarray, triangles: np.ndarray, landmarks_of: Calla
     (rotation -> Landmarks of the mesh turned by it) as few times as it can.
 
     1. No clear mirror plane: the character is taken as it is.
-    2. Its mirror plane found (:func:`mirror_frame`), it is turned so the
-       plane is x = 0, up the mesh's axis lying most in the plane: *as it is*.
+    2. Its mirror plane found (:func:`mirror_frame`; the upright plane across
+       it when the feet tell, :func:`_plane_between_the_feet`), it is turned
+       so the plane is x = 0, up the mesh's axis lying most in the plane:
+       *as it is*.
     3. Other ways of standing it (:data:`.up_features.UP_CANDIDATES`) are
        read when the character as it is does not read as a standing biped
        or quadruped (:data:`.standard_skeleton.KIND_CONFIDENCE`; then the
@@ -402,11 +407,13 @@ def _plane_between_the_feet(points: np.ndarray, triangles: np.ndarray, frame: np
 def _feet_midline(framed: np.ndarray, triangles: np.ndarray) -> float:
     """The share of the lowest height band's area (:data:`.up_features.UP_BANDS`)
     within :data:`.up_features.MIDLINE_SHARE` of its half width of the band's
-    own centre along x."""
+    own centre along x (1 when the band has no width)."""
     surface, shares = area_centroids(framed, triangles)
     heights = surface[:, 2] - surface[:, 2].min()
     band = heights < heights.max() / UP_BANDS
     x = surface[band, 0] - 0.5 * (surface[band, 0].min() + surface[band, 0].max())
+    if not np.abs(x).max() > 0:
+        return 1.0  # a band without width lies wholly on its midline: it splits nothing
     weights = shares[band] / max(shares[band].sum(), 1e-300)
     return float(weights[np.abs(x) < MIDLINE_SHARE * np.abs(x).max()].sum())
 
