@@ -108,23 +108,39 @@ def write_box_character_gltf(path, bones) -> None:
         matrix = np.eye(4)
         matrix[:3, 3] = -head
         inverse_binds.append(matrix.T.ravel())  # glTF matrices are column-major
-    blobs = [positions.tobytes(), joint_ids.tobytes(), weights.tobytes(), indices.tobytes(),
-             np.array(inverse_binds, np.float32).tobytes()]
-    padded = [blob + b"\0" * (-len(blob) % 4) for blob in blobs]
-    offsets = np.cumsum([0] + [len(blob) for blob in padded])
-    buffer = b"".join(padded)
     nodes = [{"name": name, "translation": [float(x) for x in heads[joint] - (heads[parent] if parent >= 0 else 0)]}
              for joint, (name, parent, _, _) in enumerate(bones)]
     for joint, (_, parent, _, _) in enumerate(bones):
         if parent >= 0:
             nodes[parent].setdefault("children", []).append(joint)
     roots = [joint for joint, (_, parent, _, _) in enumerate(bones) if parent < 0]
-    nodes.append({"name": "Body", "mesh": 0, "skin": 0})
+    write_skinned_gltf(path, nodes, roots, list(range(len(bones))), positions, joint_ids, weights, indices,
+                       inverse_binds)
+
+
+def write_skinned_gltf(path, nodes, roots, joints, positions, joint_ids, weights, indices, inverse_binds) -> None:
+    """A .gltf, its buffer embedded, of one skinned triangle mesh ``Body`` added after ``nodes``.
+
+    Parameters
+    ----------
+    nodes : list of glTF node dicts (an armature node, joints; ``children`` index among them)
+    roots : indices of the scene's root nodes among ``nodes``
+    joints : indices of the skin's joints among ``nodes``, in skin order; the first is its skeleton
+    positions : (n, 3) float32, glTF's Y-up; joint_ids : (n, 4) uint8; weights : (n, 4) float32
+    indices : (3m,) uint16 triangle corners
+    inverse_binds : one (16,) column-major matrix per joint of the skin
+    """
+    blobs = [positions.tobytes(), joint_ids.tobytes(), weights.tobytes(), indices.tobytes(),
+             np.array(inverse_binds, np.float32).tobytes()]
+    padded = [blob + b"\0" * (-len(blob) % 4) for blob in blobs]
+    offsets = np.cumsum([0] + [len(blob) for blob in padded])
+    buffer = b"".join(padded)
+    nodes = list(nodes) + [{"name": "Body", "mesh": 0, "skin": 0}]
     document = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": roots + [len(nodes) - 1]}], "nodes": nodes,
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": list(roots) + [len(nodes) - 1]}], "nodes": nodes,
         "meshes": [{"name": "Body", "primitives": [
             {"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}, "indices": 3}]}],
-        "skins": [{"joints": list(range(len(bones))), "inverseBindMatrices": 4, "skeleton": roots[0]}],
+        "skins": [{"joints": joints, "inverseBindMatrices": 4, "skeleton": joints[0]}],
         "buffers": [{"byteLength": len(buffer),
                      "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii")}],
         "bufferViews": [{"buffer": 0, "byteOffset": int(offset), "byteLength": len(blob)}
@@ -135,7 +151,7 @@ def write_box_character_gltf(path, bones) -> None:
             {"bufferView": 1, "componentType": 5121, "count": len(positions), "type": "VEC4"},
             {"bufferView": 2, "componentType": 5126, "count": len(positions), "type": "VEC4"},
             {"bufferView": 3, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
-            {"bufferView": 4, "componentType": 5126, "count": len(bones), "type": "MAT4"},
+            {"bufferView": 4, "componentType": 5126, "count": len(inverse_binds), "type": "MAT4"},
         ],
     }
     path.write_text(json.dumps(document), encoding="utf-8")

@@ -1,9 +1,6 @@
 """Bone tails derived from the joints (autorig_addon.core.skeleton.tails), and
 their use when a glTF file's importer bones come out point-like."""
 
-import base64
-import json
-
 import numpy as np
 import pytest
 
@@ -18,7 +15,7 @@ from autorig_addon.core.skeleton.tails import (
     with_reliable_tails,
 )
 from autorig_addon.core.types import Skeleton
-from gltf_fixtures import write_box_character_gltf
+from gltf_fixtures import write_box_character_gltf, write_skinned_gltf
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -260,40 +257,14 @@ def write_point_like_gltf(path) -> None:
         matrix[3, 3] = 1.0
         matrix[1, 3] = -JOINT_STEP * k
         inverse_binds.append(matrix.T.ravel())  # glTF matrices are column-major
-    blobs = [positions.tobytes(), joint_ids.tobytes(), weights.tobytes(), indices.tobytes(),
-             np.array(inverse_binds, dtype=np.float32).tobytes()]
-    padded = [blob + b"\0" * (-len(blob) % 4) for blob in blobs]
-    offsets = np.cumsum([0] + [len(blob) for blob in padded])
-    buffer = b"".join(padded)
     nodes = [{"name": "Armature", "scale": [ARMATURE_SCALE] * 3, "children": [1]}]
     for k in range(CHAIN_JOINTS):
         node = {"name": f"Bone{k}", "translation": [0.0, JOINT_STEP if k else 0.0, 0.0]}
         if k + 1 < CHAIN_JOINTS:
             node["children"] = [k + 2]
         nodes.append(node)
-    nodes.append({"name": "Body", "mesh": 0, "skin": 0})
-    document = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0, len(nodes) - 1]}],
-        "nodes": nodes,
-        "meshes": [{"name": "Body", "primitives": [
-            {"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}, "indices": 3}]}],
-        "skins": [{"joints": list(range(1, CHAIN_JOINTS + 1)), "inverseBindMatrices": 4, "skeleton": 1}],
-        "buffers": [{"byteLength": len(buffer),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii")}],
-        "bufferViews": [{"buffer": 0, "byteOffset": int(offset), "byteLength": len(blob)}
-                        for offset, blob in zip(offsets, blobs)],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3",
-             "min": positions.min(0).tolist(), "max": positions.max(0).tolist()},
-            {"bufferView": 1, "componentType": 5121, "count": len(positions), "type": "VEC4"},
-            {"bufferView": 2, "componentType": 5126, "count": len(positions), "type": "VEC4"},
-            {"bufferView": 3, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
-            {"bufferView": 4, "componentType": 5126, "count": CHAIN_JOINTS, "type": "MAT4"},
-        ],
-    }
-    path.write_text(json.dumps(document), encoding="utf-8")
+    write_skinned_gltf(path, nodes, [0], list(range(1, CHAIN_JOINTS + 1)), positions, joint_ids, weights, indices,
+                       inverse_binds)
 
 
 def test_point_like_gltf_bones_get_tails_on_the_child_heads(clean_scene, tmp_path):
