@@ -43,7 +43,7 @@ def outcome(sample: CharacterSample, turn: np.ndarray) -> str:
     proxy = simplified_proxy(Mesh(sample.vertices @ turn.T, sample.triangles), PROXY_VERTICES).mesh
 
     def reading(rotation):
-        graph = predict._read_shape(proxy, predict.framed_transform(proxy.vertices, rotation), None)[0]
+        graph = predict._read_shape(proxy, predict.framed_transform(proxy.vertices, rotation, proxy.triangles), None)[0]
         landmarks, turned = predict_landmarks(graph), predict_landmarks(half_turned(graph))
         return landmarks if standard_confidence(landmarks) >= standard_confidence(turned) else turned
 

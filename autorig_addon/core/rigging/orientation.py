@@ -393,8 +393,8 @@ def _plane_between_the_feet(points: np.ndarray, triangles: np.ndarray, frame: np
     normal = across[0]
     if normal[0] < -1e-12 or (abs(normal[0]) <= 1e-12 and normal[1] < 0):
         across = np.diag([-1.0, -1.0, 1.0]) @ across  # the same plane, signed as mirror_frame signs it
-    if (_feet_midline(points @ frame.T, triangles) < FEET_STRADDLED
-            or _feet_midline(points @ across.T, triangles) > FEET_SPLIT):
+    if (feet_across(points @ frame.T, triangles)[0] < FEET_STRADDLED
+            or feet_across(points @ across.T, triangles)[0] > FEET_SPLIT):
         return frame, []
     tree = cKDTree(points)
     if mirror_error_across(points, across[0], tree) > FEET_ACROSS_ERROR_RATIO * mirror_error_across(points, frame[0],
@@ -404,18 +404,21 @@ def _plane_between_the_feet(points: np.ndarray, triangles: np.ndarray, frame: np
                     "so that one was taken as its mirror plane (an arm raised on one side, say)."]
 
 
-def _feet_midline(framed: np.ndarray, triangles: np.ndarray) -> float:
-    """The share of the lowest height band's area (:data:`.up_features.UP_BANDS`)
-    within :data:`.up_features.MIDLINE_SHARE` of its half width of the band's
-    own centre along x (1 when the band has no width)."""
+def feet_across(framed: np.ndarray, triangles: np.ndarray) -> tuple[float, float]:
+    """The lowest height band (:data:`.up_features.UP_BANDS`) of a mesh
+    standing along +z, measured along x about the band's own centre (so that
+    an arm raised on one side does not move it): the share of its area
+    within :data:`.up_features.MIDLINE_SHARE` of its half width of that
+    centre (1 when the band has no width), and the centre's x."""
     surface, shares = area_centroids(framed, triangles)
     heights = surface[:, 2] - surface[:, 2].min()
     band = heights < heights.max() / UP_BANDS
-    x = surface[band, 0] - 0.5 * (surface[band, 0].min() + surface[band, 0].max())
+    centre = 0.5 * float(surface[band, 0].min() + surface[band, 0].max())
+    x = surface[band, 0] - centre
     if not np.abs(x).max() > 0:
-        return 1.0  # a band without width lies wholly on its midline: it splits nothing
+        return 1.0, centre  # a band without width lies wholly on its midline: it splits nothing
     weights = shares[band] / max(shares[band].sum(), 1e-300)
-    return float(weights[np.abs(x) < MIDLINE_SHARE * np.abs(x).max()].sum())
+    return float(weights[np.abs(x) < MIDLINE_SHARE * np.abs(x).max()].sum()), centre
 
 
 def _stands_on_its_head(framed: np.ndarray, triangles: np.ndarray) -> bool:
