@@ -280,6 +280,11 @@ def sure_standard_kind(landmarks: Landmarks) -> str | None:
     return landmarks.kind if sure else None
 
 
+#: A shift of the midline (:func:`framed_transform`) smaller than this share
+#: of the largest side is rounding, not a pose.
+CENTRE_SHIFT_NOISE = 1e-6
+
+
 def framed_transform(vertices: np.ndarray, rotation: np.ndarray, triangles: np.ndarray | None = None) -> np.ndarray:
     """(4, 4) from the mesh's space to the normalised frame of ``vertices``
     turned by ``rotation`` (3, 3) first (:func:`.orientation.stand_upright`).
@@ -304,9 +309,11 @@ def framed_transform(vertices: np.ndarray, rotation: np.ndarray, triangles: np.n
     transform = normalisation_transform(turned)
     if triangles is not None and len(triangles):
         between, centre = feet_across(turned, triangles)
-        if between < STANDING_MIDLINE:
-            box_centre = 0.5 * (turned[:, 0].min() + turned[:, 0].max())
-            transform[:3, 3] -= transform[:3, :3] @ np.array([centre - box_centre, 0.0, 0.0])
+        shift = centre - 0.5 * (turned[:, 0].min() + turned[:, 0].max())
+        # Rounding noise is no shift: a symmetric body's midline vertices must stay at exactly x = 0, where
+        # pairing left and right decides by sign (the same body wound the other way must give the same skeleton).
+        if between < STANDING_MIDLINE and abs(shift) * transform[0, 0] > CENTRE_SHIFT_NOISE:
+            transform[:3, 3] -= transform[:3, :3] @ np.array([shift, 0.0, 0.0])
     return transform @ turn
 
 
