@@ -114,9 +114,10 @@ def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> 
     vertices = mesh.vertices
     kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
     triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)]
-    triangles = triangles[triangle_double_areas(vertices, triangles) > 0]
+    double_areas = triangle_double_areas(vertices, triangles)
+    triangles, double_areas = triangles[double_areas > 0], double_areas[double_areas > 0]
     owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
-    area = 0.5 * np.bincount(owner, weights=triangle_double_areas(vertices, triangles), minlength=objects)
+    area = 0.5 * np.bincount(owner, weights=double_areas, minlength=objects)
     told = set(int(index) for index in told)
     thin = {}
     for index in range(objects):

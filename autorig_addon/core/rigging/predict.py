@@ -285,12 +285,12 @@ def sure_standard_kind(landmarks: Landmarks) -> str | None:
 CENTRE_SHIFT_NOISE = 1e-6
 
 
-def framed_transform(vertices: np.ndarray, rotation: np.ndarray, triangles: np.ndarray | None = None) -> np.ndarray:
+def framed_transform(vertices: np.ndarray, rotation: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(4, 4) from the mesh's space to the normalised frame of ``vertices``
     turned by ``rotation`` (3, 3) first (:func:`.orientation.stand_upright`).
 
-    The networks put the midline at x = 0, the box centre. With
-    ``triangles``, a body standing on feet apart (:func:`.orientation.feet_across`:
+    The networks put the midline at x = 0, the box centre. A body
+    (``vertices`` and ``triangles``) standing on feet apart (:func:`.orientation.feet_across`:
     under :data:`.orientation.STANDING_MIDLINE` of its lowest band between
     them) is centred between its feet instead: an arm turned on one side
     moves the box centre, not the feet. The procedural biped with its left
@@ -307,7 +307,7 @@ def framed_transform(vertices: np.ndarray, rotation: np.ndarray, triangles: np.n
     turn[:3, :3] = rotation
     turned = vertices @ rotation.T
     transform = normalisation_transform(turned)
-    if triangles is not None and len(triangles):
+    if len(triangles):
         between, centre = feet_across(turned, triangles)
         shift = centre - 0.5 * (turned[:, 0].min() + turned[:, 0].max())
         # Rounding noise is no shift: a symmetric body's midline vertices must stay at exactly x = 0, where
