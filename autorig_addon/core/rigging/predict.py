@@ -43,11 +43,11 @@ from .connectivity import bone_probabilities, oriented_tree, root_scores, spanni
 from .facing import facing, from_behind, front_untold_note, half_turned
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
-from .leg_length import TYPICAL_CROTCH_SHARE, points_back, short_leg_map, stretched
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .networks.landmarks import STANDARD_KINDS
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
+from .proportions import TYPICAL_CROTCH_SHARE, TYPICAL_NECK_SHARE, points_back, stretched, typical_proportions
 from .quality import skeleton_problems
 from .rig_library import closest_rig
 from .role_names import role_names
@@ -240,8 +240,9 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
         notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
                      "from behind and turned back.")
-    landmarks, leg_notes = _short_legs_read_again(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
-    notes += leg_notes
+    landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
+                                                                     landmarks)
+    notes += proportion_notes
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, landmarks.kind))
@@ -254,23 +255,31 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                    surface=normalised_surface)
 
 
-def _short_legs_read_again(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> tuple[Landmarks, tuple]:
+def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth,
+                                       landmarks: Landmarks) -> tuple[Landmarks, tuple]:
     """A biped's landmarks read again on its body (``normalised``: the proxy
-    in the normalised frame, ``solid`` its solid) stretched to typical leg
-    length when they put its hip joints far above its crotch
-    (:mod:`.leg_length`), mapped back; else ``landmarks`` as they are. Also
-    the note saying so."""
+    in the normalised frame, ``solid`` its solid) mapped to typical
+    proportions when they put its hip joints far above its crotch or its
+    neck far above its neck's pinch (:mod:`.proportions`), mapped back;
+    else ``landmarks`` as they are. Also the note saying so."""
     if sure_standard_kind(landmarks) != BIPED:
         return landmarks, ()
     top = float(normalised.vertices[:, 2].max())
-    height_map = short_leg_map(landmarks.points, solid, top)
-    if height_map is None:
+    found = typical_proportions(landmarks.points, solid, top)
+    if found is None:
         return landmarks, ()
-    body, stretch = stretched(normalised, height_map)
+    body, stretch = stretched(normalised, found.height_map)
     reread = predict_landmarks(joint_graph(body))
-    note = (f"The legs are short (crotch at {height_map.crotch / top:.0%} of the height) and were first read as "
-            f"longer: the landmarks were read again on the body stretched to a crotch at {TYPICAL_CROTCH_SHARE:.0%}.")
-    return replace(reread, points=points_back(reread.points, stretch, height_map)), (note,)
+    if found.big_head:
+        crotch = "" if found.crotch is None else f", crotch at {found.crotch / top:.0%}"
+        note = (f"The head is big (neck at {found.neck / top:.0%} of the height{crotch}) and the neck was first read "
+                f"higher: the landmarks were read again on the body mapped to a neck at {TYPICAL_NECK_SHARE:.0%} "
+                f"and a crotch at {TYPICAL_CROTCH_SHARE:.0%} or higher.")
+    else:
+        note = (f"The legs are short (crotch at {found.crotch / top:.0%} of the height) and were first read as "
+                f"longer: the landmarks were read again on the body stretched to a crotch at "
+                f"{TYPICAL_CROTCH_SHARE:.0%}.")
+    return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
 
 
 def sure_standard_kind(landmarks: Landmarks) -> str | None:

@@ -1,0 +1,181 @@
+"""Short legs and big heads read again (core/rigging/proportions.py): the
+crotch and the neck's pinch found in the solid, the map to typical
+proportions and back, a short-legged biped whose hip joints and a
+big-headed one whose neck the landmark network puts far too high at
+first."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import proportions
+from autorig_addon.core.rigging.joint_features import solid_depth
+from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.proportions import HeightMap, crotch_height, neck_pinch, typical_proportions
+from autorig_addon.core.skeleton.key_joints import key_joints
+from autorig_addon.core.types import Mesh
+from geometry_fixtures import box_mesh
+
+#: The trunk of the two-legged block body starts at this height.
+CROTCH = 0.3
+
+
+def joined(*meshes: Mesh) -> Mesh:
+    offsets = np.cumsum([0] + [mesh.vertex_count for mesh in meshes[:-1]])
+    return Mesh(np.concatenate([mesh.vertices for mesh in meshes]),
+                np.concatenate([mesh.triangles + offset for mesh, offset in zip(meshes, offsets)]))
+
+
+@pytest.fixture(scope="module")
+def block_body():
+    """Two legs (x = +-0.1, up to the crotch) under a trunk up to z = 1."""
+    legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, CROTCH], 0.05) for side in (-1, 1)]
+    trunk = box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, 1.0], 0.05)
+    return solid_depth(joined(*legs, trunk))
+
+
+def test_the_height_map_sends_each_knot_to_its_target_and_back():
+    height_map = HeightMap(heights=(0.0, 0.2, 1.0), targets=(0.0, 0.44, 1.0))
+    np.testing.assert_allclose(height_map.forward([0.0, 0.1, 0.2, 0.6, 1.0]), [0.0, 0.22, 0.44, 0.72, 1.0])
+    heights = np.linspace(0.0, 1.0, 11)
+    np.testing.assert_allclose(height_map.inverse(height_map.forward(heights)), heights)
+    # Crotch and neck: the head above 0.6 squeezed into the top 0.16.
+    height_map = HeightMap(heights=(0.0, 0.3, 0.6, 1.0), targets=(0.0, 0.44, 0.84, 1.0))
+    np.testing.assert_allclose(height_map.forward([0.15, 0.45, 0.8]), [0.22, 0.64, 0.92])
+    np.testing.assert_allclose(height_map.inverse(height_map.forward(heights)), heights)
+
+
+def test_the_crotch_is_where_the_line_between_the_knees_enters_the_solid(block_body):
+    knees = np.array([[0.1, 0.0, 0.15], [-0.1, 0.0, 0.15]])
+    # Half a voxel deep in a solid of 1/96 voxels: within a voxel of the trunk's bottom.
+    assert crotch_height(block_body, knees, top=1.0) == pytest.approx(CROTCH, abs=block_body.cell_size)
+    # Knees above the trunk's top: nothing inside below 0.8 of the height.
+    assert crotch_height(block_body, knees + [0, 0, 0.7], top=1.0) is None
+
+
+def test_only_hip_joints_far_above_the_crotch_ask_for_the_stretch(block_body):
+    points = {"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
+              "neck": np.array([0.0, 0.0, 0.9])}
+    # Hip joints 0.1 above a crotch at 0.3 (a third of its height): read as they are.
+    points.update({"hip.L": np.array([0.1, 0.0, 0.4]), "hip.R": np.array([-0.1, 0.0, 0.4])})
+    assert typical_proportions(points, block_body, top=1.0) is None
+    # 0.3 above it (a whole crotch height): the body is stretched, the crotch to 0.44 of the height.
+    points.update({"hip.L": np.array([0.1, 0.0, 0.6]), "hip.R": np.array([-0.1, 0.0, 0.6])})
+    found = typical_proportions(points, block_body, top=1.0)
+    assert found.short_legs and not found.big_head
+    assert found.height_map.heights[1] == pytest.approx(CROTCH, abs=block_body.cell_size)
+    assert found.height_map.targets == pytest.approx((0.0, proportions.TYPICAL_CROTCH_SHARE, 1.0))
+
+
+#: The block figure's neck: a narrow box from NECK to NECK + 0.05 under a wide head up to z = 1.
+NECK = 0.6
+
+
+@pytest.fixture(scope="module")
+def block_figure():
+    """Two legs up to the crotch, a trunk up to NECK, a neck a quarter as
+    wide and a head as wide as the trunk up to z = 1."""
+    legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, CROTCH], 0.05) for side in (-1, 1)]
+    trunk = box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, NECK], 0.05)
+    neck = box_mesh([-0.05, -0.04, NECK], [0.05, 0.04, NECK + 0.05], 0.05)
+    head = box_mesh([-0.2, -0.12, NECK + 0.05], [0.2, 0.12, 1.0], 0.05)
+    return solid_depth(joined(*legs, trunk, neck, head))
+
+
+def test_the_neck_is_the_pinch_between_the_chest_and_the_head(block_figure, block_body):
+    pinch = neck_pinch(block_figure, CROTCH, top=1.0)
+    assert NECK - block_figure.cell_size <= pinch <= NECK + 0.05 + block_figure.cell_size
+    # A trunk that runs straight up into the head has no neck.
+    assert neck_pinch(block_body, CROTCH, top=1.0) is None
+
+
+def test_only_a_neck_read_far_above_the_pinch_asks_for_the_map(block_figure):
+    points = {"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
+              "hip.L": np.array([0.1, 0.0, 0.32]), "hip.R": np.array([-0.1, 0.0, 0.32])}
+    # A neck read 0.02 above the pinch: as it is.
+    assert typical_proportions({**points, "neck": np.array([0.0, 0.0, NECK + 0.045])}, block_figure, 1.0) is None
+    # 0.15 above it: the pinch goes to 0.84 of the height and the crotch to 0.44.
+    found = typical_proportions({**points, "neck": np.array([0.0, 0.0, NECK + 0.175])}, block_figure, 1.0)
+    assert found.big_head and not found.short_legs
+    assert found.height_map.targets == pytest.approx(
+        (0.0, proportions.TYPICAL_CROTCH_SHARE, proportions.TYPICAL_NECK_SHARE, 1.0))
+    assert found.height_map.heights[2] == pytest.approx(found.neck)
+
+
+def short_legged_biped():
+    """The procedural biped of seed 0 with its legs below the crotch
+    squashed to 45 % of their length (a chibi's crotch at 20 % of the
+    height), and its artist's key joints moved with it."""
+    character = generate_character(0, "biped")
+    vertices = character.mesh.vertices
+    floor, top = vertices[:, 2].min(), np.ptp(vertices[:, 2])
+    truth = key_joints(character.skeleton.names, character.skeleton.joints, parents=character.skeleton.parents)
+    crotch = 0.5 * (truth.positions["hip.L"][2] + truth.positions["hip.R"][2]) - floor - 0.03 * top
+    squash = HeightMap((0.0, crotch, top), (0.0, 0.45 * crotch, top))
+
+    def squashed(points):
+        points = np.array(points, dtype=np.float64)
+        points[:, 2] = squash.forward(points[:, 2] - floor) + floor
+        return points
+
+    mesh = Mesh(squashed(vertices), character.mesh.triangles)
+    return mesh, {name: squashed(point[None])[0] for name, point in truth.positions.items()}
+
+
+def hip_joint_errors(mesh: Mesh, truth: dict) -> tuple:
+    votes = predict_votes(mesh)
+    skeleton = skeleton_from_votes(votes)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    size = np.ptp(mesh.vertices, axis=0).max()
+    return [np.linalg.norm(found[name] - truth[name]) / size for name in ("hip.L", "hip.R")], votes.notes
+
+
+def test_a_short_legged_biped_is_read_again_and_its_hip_joints_come_down(monkeypatch):
+    mesh, truth = short_legged_biped()
+    errors, notes = hip_joint_errors(mesh, truth)
+    # Measured: 0.017 of the largest side with the second reading, 0.109 without.
+    assert max(errors) < 0.05, errors
+    assert any(note.startswith("The legs are short (crotch at 18% of the height)") for note in notes), notes
+    monkeypatch.setattr(proportions, "HIP_ABOVE_CROTCH", np.inf)
+    first_reading, notes = hip_joint_errors(mesh, truth)
+    assert min(first_reading) > 0.08, first_reading
+    assert not any("legs are short" in note for note in notes)
+
+
+def big_headed_biped():
+    """The procedural biped of seed 4 with its head (the vertices its head
+    bone and the bones below it move most) scaled 4 times about the head
+    joint: a chibi, its neck at 53 % of the height."""
+    character = generate_character(4, "biped")
+    skeleton, weights = character.skeleton, character.weights
+    truth = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents)
+    head_bones = {truth.bones["head"]}
+    for bone, parent in enumerate(skeleton.parents):  # parents come first
+        if parent in head_bones:
+            head_bones.add(bone)
+    columns = [weights.bone_names.index(skeleton.names[bone]) for bone in head_bones
+               if skeleton.names[bone] in weights.bone_names]
+    in_head = np.isin(np.argmax(weights.matrix, axis=1), columns)
+    vertices = character.mesh.vertices.copy()
+    centre = truth.positions["head"]
+    vertices[in_head] = centre + 4.0 * (vertices[in_head] - centre)
+    return Mesh(vertices, character.mesh.triangles), truth.positions
+
+
+def neck_error(mesh: Mesh, truth: dict) -> tuple:
+    votes = predict_votes(mesh)
+    skeleton = skeleton_from_votes(votes)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    return np.linalg.norm(found["neck"] - truth["neck"]) / np.ptp(mesh.vertices, axis=0).max(), votes.notes
+
+
+def test_a_big_headed_biped_is_read_again_and_its_neck_comes_down(monkeypatch):
+    mesh, truth = big_headed_biped()
+    error, notes = neck_error(mesh, truth)
+    # Measured: 0.030 of the largest side with the second reading, 0.093 without.
+    assert error < 0.05, error
+    assert any(note.startswith("The head is big (neck at 57% of the height") for note in notes), notes
+    monkeypatch.setattr(proportions, "NECK_ABOVE_PINCH", np.inf)
+    first_reading, notes = neck_error(mesh, truth)
+    assert first_reading > 0.08, first_reading
+    assert not any("head is big" in note for note in notes)
