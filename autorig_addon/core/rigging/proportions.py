@@ -66,7 +66,7 @@ NECK_SEARCH_TO = 0.95
 #: A pinch is a neck when its section is at most this share of the widest
 #: section both above it (the head) and between it and the crotch (the chest,
 #: or the shoulders and arms). Chosen on the training humanoids' own rigs
-#: (154, 2026-12-07): of the 29 pinches this sharp, the pinch lies a median
+#: (154, 2026-12-06): of the 29 pinches this sharp, the pinch lies a median
 #: 0.036 of the height from the artist's neck joint (above it: artists start
 #: the neck at its base), 0.088 at most (Quaternius' mech `Stan`); softer
 #: ones include waists below the chest (`Medieval`, 0.40: 0.143 below).
