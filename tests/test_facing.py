@@ -86,6 +86,23 @@ def test_without_a_shape_cue_the_surer_reading_turned_decides():
     assert facing(landmarks_of(UNSURE), landmarks_of(UNSURE), block) == Facing(False, front_untold=True)
 
 
+def test_where_the_network_put_the_ankles_does_not_turn_a_biped_whose_toes_do_not_tell():
+    # Boots reaching as far behind the shins as ahead: the toes do not tell.
+    boots = [box for sign in (1.0, -1.0) for box in (
+        ([min(sign * 0.05, sign * 0.15), -0.03, 0.13], [max(sign * 0.05, sign * 0.15), 0.03, 0.24]),
+        ([min(sign * 0.05, sign * 0.15), -0.08, 0.0], [max(sign * 0.05, sign * 0.15), 0.08, 0.04]))]
+    body = boxes(*boots, TRUNK)
+    assert abs(toe_reach(body)) < TOE_REACH_SURE
+    # The network put the ankles at the boots' front, so the boots reach far behind them; read alike both ways.
+    points = {name: np.zeros(3) for name in LANDMARKS}
+    for name, x in (("ankle.L", 0.1), ("ankle.R", -0.1), ("hip.L", 0.1), ("hip.R", -0.1)):
+        points[name] = np.array([x, -0.06, 0.05 if name.startswith("ankle") else 0.5])
+    reading = Landmarks(points, SURE_BIPED)
+    # Kept as given either way round (a cue on the network's ankles turned such bodies whichever way they faced).
+    assert facing(reading, reading, body) == Facing(False)
+    assert facing(reading, reading, half_turn(body)) == Facing(False)
+
+
 def test_a_quadrupeds_higher_end_is_its_front():
     assert (END_SHARE, HEAD_END_SURE) == (0.15, 0.05)
     # A body along y from -0.5 to 0.5: a trunk 0.3 to 0.6 high, a head up to 0.9 at the -y end, four legs.

@@ -3,7 +3,7 @@ as the networks learnt, or +y; and what to do when the network reads it
 better the other way round.
 
 The mirror plane (:mod:`.orientation`) puts a character's left-right axis
-at x, but says nothing of which of -y and +y its front is. Three cues, in
+at x, but says nothing of which of -y and +y its front is. Two cues, in
 this order (:func:`facing`):
 
 1. **Shape cues no network reads**, so the training characters measure
@@ -14,8 +14,12 @@ this order (:func:`facing`):
 2. **The landmark network reading it far more surely as a biped or
    quadruped turned half a turn** (:data:`TURNED_CONFIDENCE_GAIN`): it
    learnt bodies facing -y, and a dog facing +y reads as "other".
-3. **A biped's feet reaching behind its ankles** (:data:`BACKWARD_FEET_RATIO`),
-   where the network put the ankles.
+
+A third cue, a biped's feet reaching 1.5 times as far behind the network's
+ankles as ahead, was dropped (2026-12-06): it never decided a training
+character's facing (every third, as loaded and turned: the same 216
+readings without it), and on validation characters it turned `Zombie_Male`
+and the cyberpunk `Character` half a turn whichever way they were given.
 
 A body kept facing -y by its shape that the network reads far more surely
 from behind (one unlike its training characters: the network saw its back
@@ -32,18 +36,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import mirror_name
 from ..types import Mesh
 from .joint_features import VERTEX_VECTORS, JointGraph
 from .standard_skeleton import BIPED, OTHER, QUADRUPED, Landmarks, standard_confidence
 from .up_features import area_centroids
-
-#: A biped faces +y when its feet reach this many times as far behind the
-#: ankles as ahead of them (toes point forward: a foot reaches about three
-#: times as far ahead of the ankle as behind it).
-BACKWARD_FEET_RATIO = 1.5
-
 
 #: Turned half a turn, a character is taken to face the other way when the
 #: landmark network is at least this much surer there that it is a biped or
@@ -211,8 +208,6 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"
         return Facing(True, reason=f"turned, it reads more surely as {kind}")
-    if landmarks.kind == BIPED and _feet_behind_ankles(landmarks, surface.vertices):
-        return Facing(True, reason="its feet reach further behind its ankles than ahead")
     return Facing(False, front_untold=kinds == (OTHER, OTHER))
 
 
@@ -225,20 +220,3 @@ def _keeps_the_head_end(reading: Landmarks, shape_kind: str) -> bool:
     stegosaurus, whose back plates stand highest, read with its head on the
     tail tip) or find its head where it is, only more surely (an elephant)."""
     return shape_kind != QUADRUPED or bool(reading.points["head"][1] < reading.points["hips"][1])
-
-
-def _feet_behind_ankles(landmarks: Landmarks, vertices: np.ndarray) -> bool:
-    """Whether a biped's feet (``vertices`` below and about its ankle
-    landmarks) reach :data:`BACKWARD_FEET_RATIO` times as far behind the
-    ankles as ahead of them."""
-    points = landmarks.points
-    ahead = behind = 0.0
-    for side in (LEFT, RIGHT):
-        ankle = points["ankle" + side]
-        radius = max(0.5 * abs(points["hip" + side][0]), 0.03)
-        foot = vertices[(vertices[:, 2] <= ankle[2]) & (np.abs(vertices[:, 0] - ankle[0]) <= radius)
-                        & (np.abs(vertices[:, 1] - ankle[1]) <= 4.0 * radius)]
-        if len(foot):
-            ahead += max(ankle[1] - float(foot[:, 1].min()), 0.0)
-            behind += max(float(foot[:, 1].max()) - ankle[1], 0.0)
-    return behind > BACKWARD_FEET_RATIO * ahead and behind > 0.0
