@@ -47,7 +47,6 @@ from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .networks.landmarks import STANDARD_KINDS
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
-from .proportions import TYPICAL_CROTCH_SHARE, TYPICAL_NECK_SHARE, points_back, stretched, typical_proportions
 from .quality import skeleton_problems
 from .rig_library import closest_rig
 from .role_names import role_names
@@ -66,6 +65,7 @@ from .standard_skeleton import (
 )
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
+from .typical_proportions import TYPICAL_CROTCH_SHARE, TYPICAL_NECK_SHARE, points_back, stretched, typical_proportions
 
 #: Mean-shift bandwidth, share of the character's largest side: the level
 #: of detail (smaller: more joints). On the held-out training characters of
@@ -260,7 +260,7 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth,
     """A biped's landmarks read again on its body (``normalised``: the proxy
     in the normalised frame, ``solid`` its solid) mapped to typical
     proportions when they put its hip joints far above its crotch or its
-    neck far above its neck's pinch (:mod:`.proportions`), mapped back;
+    neck far above its neck's pinch (:mod:`.typical_proportions`), mapped back;
     else ``landmarks`` as they are. Also the note saying so."""
     if sure_standard_kind(landmarks) != BIPED:
         return landmarks, ()

@@ -1,4 +1,4 @@
-"""Short legs and big heads read again (core/rigging/proportions.py): the
+"""Short legs and big heads read again (core/rigging/typical_proportions.py): the
 crotch and the neck's pinch found in the solid, the map to typical
 proportions and back, a short-legged biped whose hip joints and a
 big-headed one whose neck the landmark network puts far too high at
@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging import proportions
+from autorig_addon.core.rigging import typical_proportions as proportions
 from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes
-from autorig_addon.core.rigging.proportions import HeightMap, crotch_height, neck_pinch, typical_proportions
+from autorig_addon.core.rigging.typical_proportions import HeightMap, crotch_height, neck_pinch, typical_proportions
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh
