@@ -89,12 +89,34 @@ def test_the_neck_is_the_pinch_between_the_chest_and_the_head(block_figure, bloc
     assert neck_pinch(block_body, CROTCH, top=1.0) is None
 
 
+def test_the_empty_midline_above_the_crown_is_no_neck():
+    # The block body under a head ending at 0.8, with two horns (off the midline) up to 1.0.
+    legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, CROTCH], 0.05) for side in (-1, 1)]
+    horns = [box_mesh([side * 0.15 - 0.03, -0.03, 0.8], [side * 0.15 + 0.03, 0.03, 1.0], 0.05) for side in (-1, 1)]
+    horned = solid_depth(joined(*legs, box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, 0.8], 0.05), *horns))
+    assert neck_pinch(horned, CROTCH, top=1.0) is None
+    # The block figure with the same horns: its neck is still the pinch under its head.
+    neck = box_mesh([-0.05, -0.04, NECK], [0.05, 0.04, NECK + 0.05], 0.05)
+    head = box_mesh([-0.2, -0.12, NECK + 0.05], [0.2, 0.12, 0.8], 0.05)
+    figure = solid_depth(joined(*legs, box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, NECK], 0.05), neck, head, *horns))
+    assert NECK - figure.cell_size <= neck_pinch(figure, CROTCH, top=1.0) <= NECK + 0.05 + figure.cell_size
+
+
+def test_the_height_map_goes_on_along_its_end_pieces_and_refuses_knots_out_of_order():
+    height_map = HeightMap(heights=(0.0, 0.2, 1.0), targets=(0.0, 0.44, 1.0))
+    # Below the floor along the first piece (slope 2.2), above the top along the last (slope 0.7).
+    np.testing.assert_allclose(height_map.forward([-0.01, 1.1]), [-0.022, 1.07])
+    np.testing.assert_allclose(height_map.inverse(height_map.forward([-0.01, 1.1])), [-0.01, 1.1])
+    with pytest.raises(ValueError):
+        HeightMap(heights=(0.0, 0.6, 0.5, 1.0), targets=(0.0, 0.44, 0.84, 1.0))
+
+
 def test_only_a_neck_read_far_above_the_pinch_asks_for_the_map(block_figure):
     points = {"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
               "hip.L": np.array([0.1, 0.0, 0.32]), "hip.R": np.array([-0.1, 0.0, 0.32])}
-    # A neck read 0.02 above the pinch: as it is.
-    assert typical_proportions({**points, "neck": np.array([0.0, 0.0, NECK + 0.045])}, block_figure, 1.0) is None
-    # 0.15 above it: the pinch goes to 0.84 of the height and the crotch to 0.44.
+    # A neck read about 0.02 above the pinch (found at 0.609): as it is.
+    assert typical_proportions({**points, "neck": np.array([0.0, 0.0, NECK + 0.03])}, block_figure, 1.0) is None
+    # About 0.17 above it: the pinch goes to 0.84 of the height and the crotch to 0.44.
     found = typical_proportions({**points, "neck": np.array([0.0, 0.0, NECK + 0.175])}, block_figure, 1.0)
     assert found.big_head and not found.short_legs
     assert found.height_map.targets == pytest.approx(
@@ -136,7 +158,9 @@ def test_a_short_legged_biped_is_read_again_and_its_hip_joints_come_down(monkeyp
     # Measured: 0.017 of the largest side with the second reading, 0.109 without.
     assert max(errors) < 0.05, errors
     assert any(note.startswith("The legs are short (crotch at 18% of the height)") for note in notes), notes
+    # The first reading alone: neither reading again.
     monkeypatch.setattr(proportions, "HIP_ABOVE_CROTCH", np.inf)
+    monkeypatch.setattr(proportions, "NECK_ABOVE_PINCH", np.inf)
     first_reading, notes = hip_joint_errors(mesh, truth)
     assert min(first_reading) > 0.08, first_reading
     assert not any("legs are short" in note for note in notes)
@@ -175,7 +199,9 @@ def test_a_big_headed_biped_is_read_again_and_its_neck_comes_down(monkeypatch):
     # Measured: 0.030 of the largest side with the second reading, 0.093 without.
     assert error < 0.05, error
     assert any(note.startswith("The head is big (neck at 57% of the height") for note in notes), notes
+    # The first reading alone: neither reading again.
     monkeypatch.setattr(proportions, "NECK_ABOVE_PINCH", np.inf)
+    monkeypatch.setattr(proportions, "HIP_ABOVE_CROTCH", np.inf)
     first_reading, notes = neck_error(mesh, truth)
     assert first_reading > 0.08, first_reading
     assert not any("head is big" in note for note in notes)

@@ -271,10 +271,9 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth,
     body, stretch = stretched(normalised, found.height_map)
     reread = predict_landmarks(joint_graph(body))
     if found.big_head:
-        crotch = "" if found.crotch is None else f", crotch at {found.crotch / top:.0%}"
-        note = (f"The head is big (neck at {found.neck / top:.0%} of the height{crotch}) and the neck was first read "
-                f"higher: the landmarks were read again on the body mapped to a neck at {TYPICAL_NECK_SHARE:.0%} "
-                f"and a crotch at {TYPICAL_CROTCH_SHARE:.0%} or higher.")
+        note = (f"The head is big (neck at {found.neck / top:.0%} of the height, crotch at {found.crotch / top:.0%}) "
+                f"and the neck was first read higher: the landmarks were read again on the body mapped to a neck at "
+                f"{TYPICAL_NECK_SHARE:.0%} and a crotch at {TYPICAL_CROTCH_SHARE:.0%} or higher.")
     else:
         note = (f"The legs are short (crotch at {found.crotch / top:.0%} of the height) and were first read as "
                 f"longer: the landmarks were read again on the body stretched to a crotch at "

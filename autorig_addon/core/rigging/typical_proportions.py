@@ -109,10 +109,11 @@ def trunk_sections(solid: SolidDepth) -> tuple[np.ndarray, np.ndarray]:
     labels, _ = ndimage.label(occupied, structure=within_layer)
     cells = np.bincount(labels.ravel())
     cells[0] = 0
-    midline = int(np.clip(np.floor(-solid.origin[0] / solid.cell_size), 0, occupied.shape[0] - 1))
-    areas = cells[labels[midline]].max(axis=0) * solid.cell_size ** 2
     heights = solid.origin[2] + (np.arange(occupied.shape[2]) + 0.5) * solid.cell_size
-    return heights, areas
+    midline = int(np.floor(-solid.origin[0] / solid.cell_size))
+    if not 0 <= midline < occupied.shape[0]:
+        return heights, np.zeros_like(heights)  # the solid lies wholly on one side of the midline
+    return heights, cells[labels[midline]].max(axis=0) * solid.cell_size ** 2
 
 
 def neck_pinch(solid: SolidDepth, crotch: float, top: float) -> float | None:
@@ -120,9 +121,15 @@ def neck_pinch(solid: SolidDepth, crotch: float, top: float) -> float | None:
     (:func:`trunk_sections`) between :data:`NECK_SEARCH_FROM` of the way
     from the ``crotch`` to the ``top`` and :data:`NECK_SEARCH_TO` of the
     height, when it is a pinch (:data:`NECK_PINCH`) between a head and a
-    chest; else None (a monster whose head runs into its body)."""
+    chest; else None (a monster whose head runs into its body). Only
+    layers the trunk crosses count, up to the highest: above the crown,
+    ears, horns or raised arms leave the midline empty, which is no neck."""
     heights, areas = trunk_sections(solid)
-    searched = np.flatnonzero((heights > crotch + NECK_SEARCH_FROM * (top - crotch)) & (heights < NECK_SEARCH_TO * top))
+    crossed = np.flatnonzero(areas > 0.0)
+    if not len(crossed):
+        return None
+    searched = np.flatnonzero((heights > crotch + NECK_SEARCH_FROM * (top - crotch)) & (heights < NECK_SEARCH_TO * top)
+                              & (areas > 0.0) & (heights < heights[crossed[-1]]))
     if not len(searched):
         return None
     neck = searched[np.argmin(areas[searched])]
@@ -136,17 +143,36 @@ def neck_pinch(solid: SolidDepth, crotch: float, top: float) -> float | None:
 @dataclass(frozen=True)
 class HeightMap:
     """The increasing piecewise-linear map on heights that sends each of
-    ``heights`` to the matching one of ``targets`` (both increasing, from 0
-    to the top, which they keep)."""
+    ``heights`` to the matching one of ``targets`` (both strictly
+    increasing, from 0 to the top, which they keep); beyond them it goes on
+    along its end pieces (a landmark read a little below the floor maps
+    back below it)."""
 
     heights: tuple
     targets: tuple
 
+    def __post_init__(self):
+        for knots in (self.heights, self.targets):
+            if len(knots) < 2 or not np.all(np.diff(knots) > 0.0):
+                raise ValueError(f"height map knots must strictly increase, got {knots}")
+        if len(self.heights) != len(self.targets):
+            raise ValueError("a height map needs as many targets as heights")
+
     def forward(self, heights: np.ndarray) -> np.ndarray:
-        return np.interp(np.asarray(heights, dtype=np.float64), self.heights, self.targets)
+        return _piecewise_linear(heights, self.heights, self.targets)
 
     def inverse(self, heights: np.ndarray) -> np.ndarray:
-        return np.interp(np.asarray(heights, dtype=np.float64), self.targets, self.heights)
+        return _piecewise_linear(heights, self.targets, self.heights)
+
+
+def _piecewise_linear(values, knots: tuple, images: tuple) -> np.ndarray:
+    """``values`` through the piecewise-linear map sending ``knots`` to ``images``, extended along its end pieces."""
+    values = np.asarray(values, dtype=np.float64)
+    mapped = np.interp(values, knots, images)
+    below, above = values < knots[0], values > knots[-1]
+    mapped[below] = images[0] + (values[below] - knots[0]) * (images[1] - images[0]) / (knots[1] - knots[0])
+    mapped[above] = images[-1] + (values[above] - knots[-1]) * (images[-1] - images[-2]) / (knots[-1] - knots[-2])
+    return mapped
 
 
 @dataclass(frozen=True)
@@ -169,7 +195,10 @@ def typical_proportions(points: dict, solid: SolidDepth, top: float) -> Proporti
     :data:`TYPICAL_CROTCH_SHARE`) or the neck more than
     :data:`NECK_ABOVE_PINCH` above the body's neck pinch (a big head: the
     crotch, when lower, to :data:`TYPICAL_CROTCH_SHARE` too, and the pinch
-    to :data:`TYPICAL_NECK_SHARE`); None when neither holds."""
+    to :data:`TYPICAL_NECK_SHARE`); None when neither holds. The neck is
+    looked for only where the crotch is found (a long robe's open bottom
+    hides both) and counts only below :data:`TYPICAL_NECK_SHARE` (a neck
+    already that high is no big head's)."""
     crotch = crotch_height(solid, np.array([points["knee.L"], points["knee.R"]]), top)
     if crotch is not None and crotch <= 0.0:
         crotch = None
