@@ -8,9 +8,12 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging import predict
 from autorig_addon.core.rigging import typical_proportions as proportions
 from autorig_addon.core.rigging.joint_features import solid_depth
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.standard_skeleton import Landmarks
 from autorig_addon.core.rigging.typical_proportions import HeightMap, crotch_height, neck_pinch, typical_proportions
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.types import Mesh
@@ -18,6 +21,9 @@ from geometry_fixtures import box_mesh
 
 #: The trunk of the two-legged block body starts at this height.
 CROTCH = 0.3
+
+
+SURE_BIPED = {"biped": 0.95, "quadruped": 0.0, "other": 0.05}
 
 
 def joined(*meshes: Mesh) -> Mesh:
@@ -71,15 +77,19 @@ def test_only_hip_joints_far_above_the_crotch_ask_for_the_stretch(block_body):
 NECK = 0.6
 
 
-@pytest.fixture(scope="module")
-def block_figure():
+def block_figure_mesh() -> Mesh:
     """Two legs up to the crotch, a trunk up to NECK, a neck a quarter as
     wide and a head as wide as the trunk up to z = 1."""
     legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, CROTCH], 0.05) for side in (-1, 1)]
     trunk = box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, NECK], 0.05)
     neck = box_mesh([-0.05, -0.04, NECK], [0.05, 0.04, NECK + 0.05], 0.05)
     head = box_mesh([-0.2, -0.12, NECK + 0.05], [0.2, 0.12, 1.0], 0.05)
-    return solid_depth(joined(*legs, trunk, neck, head))
+    return joined(*legs, trunk, neck, head)
+
+
+@pytest.fixture(scope="module")
+def block_figure():
+    return solid_depth(block_figure_mesh())
 
 
 def test_the_neck_is_the_pinch_between_the_chest_and_the_head(block_figure, block_body):
@@ -205,3 +215,24 @@ def test_a_big_headed_biped_is_read_again_and_its_neck_comes_down(monkeypatch):
     first_reading, notes = neck_error(mesh, truth)
     assert first_reading > 0.08, first_reading
     assert not any("head is big" in note for note in notes)
+
+
+def test_a_body_read_from_behind_is_read_again_from_behind(monkeypatch, block_figure):
+    """The second reading of a body whose first was taken from behind is
+    from behind too: wrists the network puts in front of the body it is
+    shown lie behind it once that reading is turned back."""
+    seen = {name: np.zeros(3) for name in LANDMARKS}
+    seen["wrist.L"], seen["wrist.R"] = np.array([0.3, -0.05, 0.6]), np.array([-0.3, -0.05, 0.6])
+    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: Landmarks(dict(seen), SURE_BIPED))
+    first = {name: np.zeros(3) for name in LANDMARKS}
+    first.update({"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
+                  "hip.L": np.array([0.1, 0.0, 0.32]), "hip.R": np.array([-0.1, 0.0, 0.32]),
+                  "neck": np.array([0.0, 0.0, NECK + 0.175])})
+    mesh = block_figure_mesh()
+    for from_behind, wrists_side in ((False, -1.0), (True, 1.0)):
+        again, notes = predict._read_again_at_typical_proportions(mesh, block_figure, Landmarks(first, SURE_BIPED),
+                                                                  from_behind)
+        assert notes and notes[0].startswith("The head is big")
+        # The right wrist stays at the body's right (-x) either way; in front (-y) as given, behind turned back.
+        assert again.points["wrist.R"][0] < 0.0
+        assert np.sign(again.points["wrist.R"][1]) == np.sign(again.points["wrist.L"][1]) == wrists_side

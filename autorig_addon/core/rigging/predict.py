@@ -241,7 +241,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
                      "from behind and turned back.")
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
-                                                                     landmarks)
+                                                                     landmarks, way.read_from_behind)
     notes += proportion_notes
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
     if sure_standard_kind(landmarks):
@@ -255,13 +255,16 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                    surface=normalised_surface)
 
 
-def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth,
-                                       landmarks: Landmarks) -> tuple[Landmarks, tuple]:
+def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks,
+                                       read_from_behind: bool = False) -> tuple[Landmarks, tuple]:
     """A biped's landmarks read again on its body (``normalised``: the proxy
     in the normalised frame, ``solid`` its solid) mapped to typical
     proportions when they put its hip joints far above its crotch or its
     neck far above its neck's pinch (:mod:`.typical_proportions`), mapped back;
-    else ``landmarks`` as they are. Also the note saying so."""
+    else ``landmarks`` as they are. Also the note saying so. Landmarks that
+    were ``read_from_behind`` (:func:`.facing.from_behind`) are read again
+    from behind too: read as given, the body may read as another kind, or
+    with its sides swapped."""
     if sure_standard_kind(landmarks) != BIPED:
         return landmarks, ()
     top = float(normalised.vertices[:, 2].max())
@@ -269,7 +272,8 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth,
     if found is None:
         return landmarks, ()
     body, stretch = stretched(normalised, found.height_map)
-    reread = predict_landmarks(joint_graph(body))
+    graph = joint_graph(body)
+    reread = from_behind(predict_landmarks(half_turned(graph))) if read_from_behind else predict_landmarks(graph)
     if found.big_head:
         note = (f"The head is big (neck at {found.neck / top:.0%} of the height, crotch at {found.crotch / top:.0%}) "
                 f"and the neck was first read higher: the landmarks were read again on the body mapped to a neck at "
