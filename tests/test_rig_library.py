@@ -1,6 +1,8 @@
 """The rig library (core/rigging/rig_library.py): a character read as a biped
 or a quadruped takes the key joints of the nearest known rig of its kind
-when that rig's surface lies near enough, mapped onto its bounding box."""
+when that rig's surface lies near enough, mapped onto its bounding box; a
+body the landmark network reads as neither is a biped when its nearest known
+body is one, near enough."""
 
 from dataclasses import replace
 
@@ -9,10 +11,16 @@ import pytest
 
 from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging import predict, rig_library
+from autorig_addon.core.rigging import predict, rig_library, standard_skeleton
 from autorig_addon.core.rigging.nearest_character import SURFACE_POINTS
 from autorig_addon.core.rigging.networks.landmarks import sample_landmarks
-from autorig_addon.core.rigging.rig_library import RigLibrary, build_rig_library, closest_rig, twin_mirror_error
+from autorig_addon.core.rigging.rig_library import (
+    RigLibrary,
+    build_rig_library,
+    closest_rig,
+    nearest_known_body,
+    twin_mirror_error,
+)
 from autorig_addon.core.skeleton.key_joints import KEY_JOINTS, key_joints
 from autorig_addon.core.types import Mesh
 
@@ -32,7 +40,7 @@ def biped():
 
 @pytest.fixture(scope="module")
 def library(biped):
-    """A biped, a quadruped and a fish: the fish, no biped or quadruped, stays out."""
+    """A biped, a quadruped and a fish: the fish only tells a kind (other), with no key joints."""
     return build_rig_library([biped[0], procedural("quadruped")[0], procedural("fish")[0]])
 
 
@@ -40,12 +48,12 @@ def normalised_copy(sample: CharacterSample, factors) -> Mesh:
     return Mesh(sample.vertices * np.asarray(factors, dtype=np.float64), sample.triangles)
 
 
-def test_the_library_holds_the_bipeds_and_quadrupeds_with_key_joints(library, biped):
-    assert library.names.tolist() == ["procedural/biped_0", "procedural/quadruped_0"]
-    assert library.kinds.tolist() == ["biped", "quadruped"]
-    assert library.points.shape == (2, SURFACE_POINTS, 3)
-    # Every key joint of the biped; the quadruped's generator names no neck and no head joint it plays.
-    assert library.known.sum(axis=1).tolist() == [15, 13]
+def test_the_library_holds_every_character_and_the_key_joints_of_bipeds_and_quadrupeds(library, biped):
+    assert library.names.tolist() == ["procedural/biped_0", "procedural/fish_0", "procedural/quadruped_0"]
+    assert library.kinds.tolist() == ["biped", "other", "quadruped"]
+    assert library.points.shape == (3, SURFACE_POINTS, 3)
+    # Every key joint of the biped; the quadruped's generator names no neck and no head joint it plays; the fish none.
+    assert library.known.sum(axis=1).tolist() == [15, 0, 13]
     targets, _, _ = sample_landmarks(biped[0])
     np.testing.assert_allclose(library.key_joints[0], targets, atol=1e-6)
 
@@ -58,7 +66,10 @@ def test_a_rig_whose_twin_joints_are_no_mirror_images_is_left_out(biped):
     posed = replace(sample, joints=joints)
     targets, known, _ = sample_landmarks(posed)
     assert twin_mirror_error(targets, known > 0) == pytest.approx(0.08, abs=1e-6)
-    assert build_rig_library([posed]).names.tolist() == []
+    # Its surface still tells a biped; its key joints are not copied.
+    posed_library = build_rig_library([posed])
+    assert posed_library.kinds.tolist() == ["biped"] and not posed_library.known.any()
+    assert closest_rig(normalised_copy(sample, [1.0, 1.0, 1.0]), "biped", posed_library, limit=np.inf) is None
 
 
 def test_twin_mirror_error_by_hand():
@@ -136,3 +147,37 @@ def test_a_character_whose_relative_is_known_gets_its_artist_key_joints(library,
     forced, network_only = (predict.skeleton_from_votes(read, template="quadruped") for read in (votes, alone))
     np.testing.assert_allclose(forced.joints, network_only.joints, atol=1e-9)
     assert not any(note.startswith("Key joints copied") for note in predict.template_notes(votes, "quadruped"))
+
+
+def test_the_nearest_known_body_of_any_kind_tells_its_kind(library, biped):
+    relative = nearest_known_body(normalised_copy(biped[0], [1.0, 1.0, 1.0]), library)
+    assert (relative.name, relative.kind, relative.distance) == ("procedural/biped_0", "biped",
+                                                                      pytest.approx(0.0, abs=1e-3))
+    fish = procedural("fish")[0]
+    assert nearest_known_body(normalised_copy(fish, [1.0, 1.0, 1.0]), library).kind == "other"
+    # Stretched 30 % across: 0.016 away, a relative within the limit but not within half that distance.
+    stretched = normalised_copy(biped[0], [1.3, 1.0, 1.0])
+    distance = nearest_known_body(stretched, library).distance
+    assert 0.01 < distance < rig_library.RELATIVE_KIND_DISTANCE
+    assert nearest_known_body(stretched, library, limit=0.5 * distance) is None
+
+
+def test_a_body_the_network_does_not_read_surely_is_a_biped_when_its_nearest_known_body_is(library, biped,
+                                                                                             monkeypatch):
+    character = biped[1]
+    # The network never sure of a kind (as on Kenney's minis, read as "other").
+    monkeypatch.setattr(standard_skeleton, "KIND_CONFIDENCE", 1.01)
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    votes = predict.predict_votes(character.mesh)
+    assert votes.landmarks.relative.name == "procedural/biped_0"
+    assert predict.chosen_template(votes)[0] == "biped"
+    assert predict.chosen_template(votes)[1].endswith(
+        "but the closest known body, procedural/biped_0 (0.000 of the largest side away), is a biped.")
+    assert len(predict.skeleton_from_votes(votes, fingers=False).names) == 22
+    # Its key joints are then its relative's, as for a body the network reads as a biped.
+    assert votes.landmarks.closest_rig.name == "procedural/biped_0"
+    # With only a quadruped and a fish known, nothing tells its kind: the free-form skeleton.
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library.subset(library.kinds != "biped"))
+    votes = predict.predict_votes(character.mesh)
+    assert votes.landmarks.relative is None
+    assert predict.chosen_template(votes)[0] == "free-form"

@@ -83,9 +83,10 @@ def run(args: argparse.Namespace) -> int:
         from .rigging.library import write_rig_library
 
         library = write_rig_library(samples, args.output)
-        print(f"rig library: {len(library.names)} training characters ("
-              f"{int((library.kinds == 'biped').sum())} bipeds, {int((library.kinds == 'quadruped').sum())} "
-              "quadrupeds)", file=sys.stderr)
+        counts = {kind: int((library.kinds == kind).sum()) for kind in ("biped", "quadruped", "other")}
+        print(f"rig library: {len(library.names)} training characters ({counts['biped']} bipeds, "
+              f"{counts['quadruped']} quadrupeds, {counts['other']} other), key joints of "
+              f"{int(library.known.any(axis=1).sum())}", file=sys.stderr)
         return EXIT_OK
     names = NETWORK_NAMES if args.what == "skin" else RIG_NETWORK_NAMES
     if args.model not in names:

@@ -45,16 +45,14 @@ from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
-from .networks.landmarks import STANDARD_KINDS
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
 from .quality import skeleton_problems
-from .rig_library import closest_rig
+from .rig_library import closest_rig, nearest_known_body
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
     BIPED,
     FREE_FORM,
-    KIND_CONFIDENCE,
     NEAR_SYMMETRIC_ERROR,
     TEMPLATES,
     Landmarks,
@@ -66,6 +64,11 @@ from .standard_skeleton import (
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
 from .typical_proportions import TYPICAL_CROTCH_SHARE, TYPICAL_NECK_SHARE, points_back, stretched, typical_proportions
+
+#: Kinds a body's nearest known body (:func:`.rig_library.nearest_known_body`)
+#: may give it when the landmark network reads none surely: bipeds only (a
+#: velociraptor lies 0.044 from a quadruped; see :data:`.rig_library.RELATIVE_KIND_DISTANCE`).
+RELATIVE_KINDS = (BIPED,)
 
 #: Mean-shift bandwidth, share of the character's largest side: the level
 #: of detail (smaller: more joints). On the held-out training characters of
@@ -240,12 +243,16 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
         notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
                      "from behind and turned back.")
+    normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
+    if not sure_standard_kind(landmarks):
+        relative = nearest_known_body(normalised_surface)
+        if relative is not None and relative.kind in RELATIVE_KINDS:
+            landmarks = replace(landmarks, relative=relative)
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
-    normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
     if sure_standard_kind(landmarks):
-        landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, landmarks.kind))
+        landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
@@ -282,14 +289,17 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
         note = (f"The legs are short (crotch at {found.crotch / top:.0%} of the height) and were first read as "
                 f"longer: the landmarks were read again on the body stretched to a crotch at "
                 f"{TYPICAL_CROTCH_SHARE:.0%}.")
-    return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
+    return replace(reread, points=points_back(reread.points, stretch, found.height_map),
+                   relative=landmarks.relative), (note,)
 
 
 def sure_standard_kind(landmarks: Landmarks) -> str | None:
-    """The kind the landmark network reads, when it is one with a standard
-    skeleton read with at least :data:`.standard_skeleton.KIND_CONFIDENCE`; else None."""
-    sure = landmarks.kind in STANDARD_KINDS and landmarks.confidence >= KIND_CONFIDENCE
-    return landmarks.kind if sure else None
+    """The kind of standard skeleton a body gets by default
+    (:attr:`.standard_skeleton.Landmarks.standard_kind`): the kind the landmark
+    network reads, when it is one with a standard skeleton read with at least
+    :data:`.standard_skeleton.KIND_CONFIDENCE`, else its nearest known body's
+    (:data:`RELATIVE_KINDS`); else None."""
+    return landmarks.standard_kind
 
 
 #: A shift of the midline (:func:`framed_transform`) smaller than this share
@@ -385,8 +395,11 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tupl
     seen = f"the landmark network reads the body as {guess} ({confidence:.0%} sure)"
     if template != AUTO:
         return template, f"Template: standard {template} skeleton, as asked; {seen}."
-    if sure_standard_kind(votes.landmarks):
+    if votes.landmarks.read_surely:
         return guess, f"Template: standard {guess} skeleton; {seen}."
+    kind = sure_standard_kind(votes.landmarks)
+    if kind is not None:
+        return kind, f"Template: standard {kind} skeleton; {seen}, but {votes.landmarks.relative.note}."
     return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
                        "force one.")
 

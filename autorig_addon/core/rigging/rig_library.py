@@ -11,9 +11,9 @@ wrists at the hoof or at the carpus and the hips at the pelvis or at the
 tail's root, family by family.
 
 The library (``trained/rig_library.npz``, built by ``train library``)
-holds, per training biped and quadruped whose bone names give key joints,
-:data:`SURFACE_POINTS` points on its normalised surface and its key joints
-in that frame. A character the landmark network reads surely as one of
+holds, per training character, :data:`SURFACE_POINTS` points on its
+normalised surface and its kind, and for the bipeds and quadrupeds whose
+bone names give key joints, those key joints in that frame. A character the landmark network reads surely as one of
 those kinds finds the entry of its kind whose surface is nearest (symmetric
 Chamfer distance, in units of the largest side) when that distance is at
 most :data:`LIBRARY_DISTANCE`; a standard skeleton of that kind (not of a
@@ -21,6 +21,10 @@ kind the user forces instead) takes the entry's key joints, mapped by the
 per-axis affine map between the two bounding boxes, and the landmark
 network's stay for the key joints the entry lacks (KayKit's rigs have no
 neck). Run on a training character, the search finds that character itself.
+
+The same surfaces also say what kind of body a character is when the
+landmark network cannot (:func:`nearest_known_body`): Kenney's chibi minis,
+read as "other", lie nearest KayKit's chibi ranger.
 """
 
 from __future__ import annotations
@@ -78,6 +82,16 @@ SCREEN_MARGIN = 1.25
 #: (``scripts/tune_rig_library.py --check-screen``: 292 readings, the 92
 #: validation and 54 held-out training characters each read both ways).
 MEASURED_IN_FULL = 16
+#: A body the landmark network does not read surely as a biped or a
+#: quadruped is a biped when its nearest known body is one, at most this far
+#: away (:func:`nearest_known_body`). Chosen on the training characters
+#: alone (2026-12-06), each measured against the others of every family but
+#: its own: no fish, bird, quadruped or "other" body has a biped nearest
+#: within 0.053 (two snakes; Quaternius' blob Mushnubs at 0.07 and 0.087),
+#: while 167 of the 178 humanoids have one within 0.045 and 171 within
+#: 0.05. Not for quadrupeds: a velociraptor has a quadruped nearest, 0.044
+#: away.
+RELATIVE_KIND_DISTANCE = 0.045
 
 
 @dataclass(frozen=True)
@@ -87,10 +101,10 @@ class RigLibrary:
     Attributes
     ----------
     names : (n,) str, the characters (paths in the data without extension)
-    kinds : (n,) str, ``biped`` or ``quadruped``
+    kinds : (n,) str, ``biped``, ``quadruped`` or ``other`` (fish, birds and the rest)
     points : (n, SURFACE_POINTS, 3) float32, points on each normalised surface
     key_joints : (n, k, 3) float32, in :data:`..skeleton.key_joints.KEY_JOINTS` order
-    known : (n, k) bool, which key joints each rig has
+    known : (n, k) bool, which key joints each rig gives (none: the entry only tells a kind)
     boxes : (n, 2, 3) float32, each normalised mesh's bounding box (lowest, highest corner)
     """
 
@@ -138,6 +152,20 @@ class ClosestRig:
         return f"{copied}; the landmark network's kept for the {lacking} it lacks." if lacking else f"{copied}."
 
 
+@dataclass(frozen=True)
+class KnownRelative:
+    """The known body nearest a character (:func:`nearest_known_body`): its
+    name, its kind and the surface distance."""
+
+    name: str
+    kind: str
+    distance: float
+
+    @property
+    def note(self) -> str:
+        return f"the closest known body, {self.name} ({self.distance:.3f} of the largest side away), is a {self.kind}"
+
+
 @lru_cache(maxsize=1)
 def shipped_library() -> RigLibrary | None:
     """The shipped library, read once; None when the file is absent (a checkout before ``train library``)."""
@@ -146,8 +174,41 @@ def shipped_library() -> RigLibrary | None:
 
 def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
                 limit: float = LIBRARY_DISTANCE) -> ClosestRig | None:
-    """The entry of ``kind`` whose surface is nearest ``surface`` (normalised
-    frame) when at most ``limit`` away, else None.
+    """The entry of ``kind`` with key joints whose surface is nearest
+    ``surface`` (normalised frame) when at most ``limit`` away, else None
+    (:func:`_nearest_entry`)."""
+    library = shipped_library() if library is None else library
+    if library is None:
+        return None
+    found = _nearest_entry(surface, library, np.flatnonzero((library.kinds == kind) & library.known.any(axis=1)),
+                           limit)
+    if found is None:
+        return None
+    best, distance = found
+    low, high = library.boxes[best].astype(np.float64)
+    mapped = box_map(library.key_joints[best].astype(np.float64), np.array([low, high]),
+                     np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
+    points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
+    return ClosestRig(str(library.names[best]), distance, points)
+
+
+def nearest_known_body(surface: Mesh, library: RigLibrary | None = None,
+                       limit: float = RELATIVE_KIND_DISTANCE) -> KnownRelative | None:
+    """The entry of any kind whose surface is nearest ``surface`` (normalised
+    frame) when at most ``limit`` away, else None."""
+    library = shipped_library() if library is None else library
+    if library is None:
+        return None
+    found = _nearest_entry(surface, library, np.arange(len(library.names)), limit)
+    if found is None:
+        return None
+    best, distance = found
+    return KnownRelative(str(library.names[best]), str(library.kinds[best]), distance)
+
+
+def _nearest_entry(surface: Mesh, library: RigLibrary, entries: np.ndarray, limit: float) -> tuple | None:
+    """(index, distance) of the entry among ``entries`` whose surface is
+    nearest ``surface`` when at most ``limit`` away, else None.
 
     Measuring every entry in full would take about a second (162 bipeds).
     Each entry is first measured one way on :data:`SCREEN_POINTS` of its
@@ -156,10 +217,6 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     :data:`SCREEN_MARGIN` times the best so far or the limit (an entry's
     Chamfer distance is at least half its one-way distance).
     """
-    library = shipped_library() if library is None else library
-    if library is None:
-        return None
-    entries = np.flatnonzero(library.kinds == kind)
     if not len(entries):
         return None
     target = surface_points(surface.vertices, surface.triangles, SURFACE_POINTS)
@@ -175,11 +232,7 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
             best, best_distance = entries[rank], distance
     if best is None or best_distance > limit:
         return None
-    low, high = library.boxes[best].astype(np.float64)
-    mapped = box_map(library.key_joints[best].astype(np.float64), np.array([low, high]),
-                     np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
-    points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
-    return ClosestRig(str(library.names[best]), best_distance, points)
+    return int(best), float(best_distance)
 
 
 #: Largest distance (share of the largest side) from a key joint's mirror
@@ -201,10 +254,12 @@ def twin_mirror_error(key_joints: np.ndarray, known: np.ndarray) -> float:
 
 def build_rig_library(samples: list) -> RigLibrary:
     """The library of ``samples`` (normalised CharacterSamples), by name:
-    those of a kind of :data:`.networks.landmarks.STANDARD_KINDS` (the split's category,
-    :data:`.networks.landmarks.CATEGORY_KINDS`) whose bone names give a key
-    joint (:func:`.networks.landmarks.sample_landmarks`, the landmark
-    network's own targets) and whose twin key joints are mirror images
+    every one, with its kind (the split's category,
+    :data:`.networks.landmarks.CATEGORY_KINDS`: biped, quadruped, or other
+    for the rest). Key joints are kept for those of a kind of
+    :data:`.networks.landmarks.STANDARD_KINDS` whose bone names give one
+    (:func:`.networks.landmarks.sample_landmarks`, the landmark network's own
+    targets) and whose twin key joints are mirror images
     (:data:`MAX_TWIN_MIRROR_ERROR`): Nexuiz's and some SuperTuxKart
     characters rest in a pose, and one 0 A.D. elephant's left legs are
     rigged elsewhere than its body's, while a standard skeleton is built
@@ -212,14 +267,13 @@ def build_rig_library(samples: list) -> RigLibrary:
     names, kinds, points, key_joints, known, boxes = [], [], [], [], [], []
     for sample in sorted(samples, key=lambda sample: sample.name):
         targets, known_joints, kind = sample_landmarks(sample)
-        if (BODY_KINDS[kind] not in STANDARD_KINDS or not known_joints.any()
-                or twin_mirror_error(targets, known_joints > 0) > MAX_TWIN_MIRROR_ERROR):
-            continue
+        copied = (BODY_KINDS[kind] in STANDARD_KINDS and known_joints.any()
+                  and twin_mirror_error(targets, known_joints > 0) <= MAX_TWIN_MIRROR_ERROR)
         names.append(sample.name)
         kinds.append(BODY_KINDS[kind])
         points.append(surface_points(sample.vertices, sample.triangles, SURFACE_POINTS))
-        key_joints.append(targets)
-        known.append(known_joints > 0)
+        key_joints.append(targets if copied else np.zeros_like(targets))
+        known.append(known_joints > 0 if copied else np.zeros(len(known_joints), dtype=bool))
         boxes.append([sample.vertices.min(axis=0), sample.vertices.max(axis=0)])
     return RigLibrary(np.array(names), np.array(kinds), np.array(points, dtype=np.float32),
                       np.array(key_joints, dtype=np.float32), np.array(known, dtype=bool),

@@ -49,8 +49,8 @@ from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import JointGraph
 from .networks import landmarks as landmark_network
-from .networks.landmarks import BODY_KINDS, LANDMARKS
-from .rig_library import ClosestRig
+from .networks.landmarks import BODY_KINDS, LANDMARKS, STANDARD_KINDS
+from .rig_library import ClosestRig, KnownRelative
 
 BIPED, QUADRUPED, OTHER = BODY_KINDS
 #: Template choices: the network's guess, one kind forced, or the free-form skeleton.
@@ -89,25 +89,43 @@ class Landmarks:
     kind_probabilities : dict mapping each kind of :data:`BODY_KINDS` to its probability
     closest_rig : ClosestRig, the known rig of the kind read whose key joints
         stand in for the network's (:mod:`.rig_library`); None when none lies near
+    relative : KnownRelative, the nearest known body when it tells the kind the
+        network does not read surely (:func:`.rig_library.nearest_known_body`); else None
     """
 
     points: dict
     kind_probabilities: dict
     closest_rig: ClosestRig | None = None
+    relative: KnownRelative | None = None
 
     @property
     def kind(self) -> str:
+        """The kind the network reads likeliest."""
         return max(self.kind_probabilities, key=self.kind_probabilities.get)
 
     @property
     def confidence(self) -> float:
         return float(self.kind_probabilities[self.kind])
 
+    @property
+    def read_surely(self) -> bool:
+        """Whether the network reads a biped or quadruped with at least :data:`KIND_CONFIDENCE`."""
+        return self.kind in STANDARD_KINDS and self.confidence >= KIND_CONFIDENCE
+
+    @property
+    def standard_kind(self) -> str | None:
+        """The kind of standard skeleton the body gets by default: the
+        network's, when it reads one surely (:attr:`read_surely`); else its
+        known relative's; else None."""
+        if self.read_surely:
+            return self.kind
+        return self.relative.kind if self.relative is not None else None
+
     def copied_for(self, kind: str) -> ClosestRig | None:
         """The known rig whose key joints a standard skeleton of ``kind`` takes:
         the closest rig only for the kind it was found for (a biped forced
         on a body read as a quadruped keeps the network's points)."""
-        return self.closest_rig if kind == self.kind else None
+        return self.closest_rig if kind == self.standard_kind else None
 
     def points_for(self, kind: str) -> dict:
         """The key joints a standard skeleton of ``kind`` is built on: the
