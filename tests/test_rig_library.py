@@ -11,7 +11,7 @@ import pytest
 
 from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging import predict, rig_library, standard_skeleton
+from autorig_addon.core.rigging import predict, rig_library
 from autorig_addon.core.rigging.nearest_character import SURFACE_POINTS
 from autorig_addon.core.rigging.networks.landmarks import sample_landmarks
 from autorig_addon.core.rigging.rig_library import (
@@ -162,22 +162,58 @@ def test_the_nearest_known_body_of_any_kind_tells_its_kind(library, biped):
     assert nearest_known_body(stretched, library, limit=0.5 * distance) is None
 
 
-def test_a_body_the_network_does_not_read_surely_is_a_biped_when_its_nearest_known_body_is(library, biped,
-                                                                                             monkeypatch):
+@pytest.fixture
+def read_as_other(monkeypatch):
+    """The landmark network's points, but every body read as "other" (as Kenney's minis are, up to 100 % sure)."""
+    network = predict.predict_landmarks
+    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: replace(
+        network(graph), kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9}))
+
+
+def test_a_body_read_as_other_is_a_biped_when_its_nearest_known_body_is(library, biped, read_as_other, monkeypatch):
     character = biped[1]
-    # The network never sure of a kind (as on Kenney's minis, read as "other").
-    monkeypatch.setattr(standard_skeleton, "KIND_CONFIDENCE", 1.01)
+    size = float(np.ptp(character.mesh.vertices, axis=0).max())
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
     votes = predict.predict_votes(character.mesh)
-    assert votes.landmarks.relative.name == "procedural/biped_0"
-    assert predict.chosen_template(votes)[0] == "biped"
-    assert predict.chosen_template(votes)[1].endswith(
-        "but the closest known body, procedural/biped_0 (0.000 of the largest side away), is a biped.")
-    assert len(predict.skeleton_from_votes(votes, fingers=False).names) == 22
-    # Its key joints are then its relative's, as for a body the network reads as a biped.
-    assert votes.landmarks.closest_rig.name == "procedural/biped_0"
+    assert votes.landmarks.kind == "other" and votes.landmarks.relative.name == "procedural/biped_0"
+    kind, note = predict.chosen_template(votes)
+    assert kind == "biped"
+    assert note == ("Template: standard biped skeleton; the landmark network reads the body as other (90% sure), not "
+                    "surely a biped or quadruped; the closest known body, procedural/biped_0 (0.000 of the largest "
+                    "side away), is a biped.")
+    # Its key joints are its relative's, as for a body the network reads as a biped.
+    assert any(note.startswith("Key joints copied from the closest known rig, procedural/biped_0")
+               for note in predict.template_notes(votes))
+    skeleton = predict.skeleton_from_votes(votes, fingers=False)
+    assert len(skeleton.names) == 22
+    assert max(key_joint_errors(skeleton, character.skeleton, size).values()) < 1e-6
     # With only a quadruped and a fish known, nothing tells its kind: the free-form skeleton.
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library.subset(library.kinds != "biped"))
     votes = predict.predict_votes(character.mesh)
     assert votes.landmarks.relative is None
     assert predict.chosen_template(votes)[0] == "free-form"
+
+
+def test_a_quadruped_nearest_gives_no_kind(library, read_as_other, monkeypatch):
+    # The quadruped itself is known, 0 away: bipeds alone are given by their nearest known body.
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    quadruped = procedural("quadruped")[1]
+    assert nearest_known_body(normalised_copy(procedural("quadruped")[0], [1.0, 1.0, 1.0]), library).kind == "quadruped"
+    votes = predict.predict_votes(quadruped.mesh)
+    assert votes.landmarks.relative is None
+    assert predict.chosen_template(votes)[0] == "free-form"
+
+
+def test_a_biped_by_its_nearest_known_body_facing_plus_y_is_turned_by_its_toes(library, biped, read_as_other,
+                                                                             monkeypatch):
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    character = biped[1]
+    # Given facing +Y: its own left lies at -X.
+    turned = Mesh(character.mesh.vertices * np.array([-1.0, -1.0, 1.0]), character.mesh.triangles)
+    votes = predict.predict_votes(turned)
+    assert "The character faces away from -Y (its toes point toward +Y); it was turned half a turn for the " \
+           "prediction, so its .L bones lie on its own left." in votes.notes
+    assert not any(note.startswith("Which way the character faces could not be told") for note in votes.notes)
+    skeleton = predict.skeleton_from_votes(votes, fingers=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    assert found["shoulder.L"][0] < 0.0 < found["shoulder.R"][0]

@@ -163,13 +163,19 @@ class Facing:
     front_untold: bool = False
 
 
-def front_untold_note(front: str) -> str:
+def front_untold_note(front: str, biped: bool = False) -> str:
     """The report's note when nothing tells which way a body faces
-    (``front``: the mesh-space axis it was taken to face, '-Y', '+X'...).
-    Its shape alone does not: a linear score of the front-to-back profile
-    (area, height, width and spread per band) told the front of 14 of the 23
-    validation fish, flyers and monsters (``scripts/check_front_profile.py``;
-    docs/rigging.md, *Orientation*)."""
+    (``front``: the mesh-space axis it was taken to face, '-Y', '+X'...);
+    ``biped``: a body its nearest known body makes a biped, whose toes do
+    not tell either. Its shape alone does not: a linear score of the
+    front-to-back profile (area, height, width and spread per band) told the
+    front of 14 of the 23 validation fish, flyers and monsters
+    (``scripts/check_front_profile.py``; docs/rigging.md, *Orientation*)."""
+    if biped:
+        return (f"Which way the character faces could not be told (the landmark network reads it as neither a biped "
+                f"nor a quadruped either way round, and its toes do not tell): it was taken to face {front} of its "
+                "own space, so its .L bones lie on its left seen so. If it faces another way, turn it to face -Y and "
+                "predict again.")
     return (f"Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either "
             f"way round): it was taken to face {front} of its own space, so its .L bones lie on its left seen so, and "
             "a chain running away from that end is its tail. If it faces another way, turn it to face -Y and predict "

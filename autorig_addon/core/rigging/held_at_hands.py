@@ -19,7 +19,7 @@ where they touch the body does. Here:
    the body without the candidates; a candidate is held when most of where
    it touches the body (:data:`AT_HAND_SHARE`) lies within
    :data:`HAND_REACH` of the body's largest side of a wrist, on a body read
-   surely as a biped, and most of it reaches beyond that
+   as a biped (surely, or by its nearest known body), and most of it reaches beyond that
    (:data:`BEYOND_HAND_SHARE`). Wings and ears touch the back and the head;
    a cape the neck; a hand, a glove or a gauntlet of its own (or both hands
    in one object, which is thin across the two) lies within a hand's reach
@@ -62,7 +62,7 @@ AT_HAND_SHARE = 0.5
 BEYOND_HAND_SHARE = 0.5
 #: The wrists the landmark network reads, left and right (core.skeleton.key_joints).
 WRISTS = ("wrist.L", "wrist.R")
-#: Only a body read surely as a biped has hands to hold with.
+#: Only a body read as a biped (surely, or by its nearest known body) has hands to hold with.
 HOLDING_KIND = BODY_KINDS[0]
 
 
@@ -182,8 +182,8 @@ def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=())
 
     The landmark network reads the body (``mesh`` without ``left_out``, the
     ``told`` props and the candidates) only when there is a candidate; a
-    body it cannot read (too few faces), or does not read surely as a biped,
-    holds nothing.
+    body it cannot read (too few faces), or does not read as a biped (surely,
+    or by its nearest known body), holds nothing.
 
     Parameters
     ----------

@@ -40,14 +40,14 @@ from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
-from .facing import facing, from_behind, front_untold_note, half_turned
+from .facing import TOE_REACH_SURE, facing, from_behind, front_untold_note, half_turned, toe_reach
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
 from .quality import skeleton_problems
-from .rig_library import closest_rig, nearest_known_body
+from .rig_library import KnownRelative, closest_rig, nearest_known_body
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
@@ -236,18 +236,29 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         transform, graph, solid, landmarks = read(rotation)
         notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
                      "prediction, so its .L bones lie on its own left.")
-    elif way.front_untold:
-        notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
     if way.read_from_behind:
         landmarks = from_behind(turned)
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
         notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
                      "from behind and turned back.")
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
-    if not sure_standard_kind(landmarks):
-        relative = nearest_known_body(normalised_surface)
-        if relative is not None and relative.kind in RELATIVE_KINDS:
-            landmarks = replace(landmarks, relative=relative)
+    relative = None if sure_standard_kind(landmarks) else _relative_of_kind(normalised_surface)
+    if way.front_untold and relative is not None:
+        # Read as neither kind either way round, the body is a biped by its nearest known body: its toes tell its front.
+        toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
+        if toes is not None and toes < -TOE_REACH_SURE:
+            rotation = HALF_TURN @ rotation
+            transform, graph, solid, landmarks = read(rotation)
+            normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
+            relative = _relative_of_kind(normalised_surface)
+            notes.append("The character faces away from -Y (its toes point toward +Y); it was turned half a turn for "
+                         "the prediction, so its .L bones lie on its own left.")
+        elif toes is None or toes <= TOE_REACH_SURE:
+            notes.append(front_untold_note(axis_name(-rotation[1]), biped=True))
+    elif way.front_untold:
+        notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
+    if relative is not None:
+        landmarks = replace(landmarks, relative=relative)
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
@@ -260,6 +271,14 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
                    surface=normalised_surface)
+
+
+def _relative_of_kind(normalised_surface: Mesh) -> KnownRelative | None:
+    """The nearest known body of a body the landmark network does not read
+    surely (:func:`.rig_library.nearest_known_body`), when it is of a kind of
+    :data:`RELATIVE_KINDS`; else None."""
+    relative = nearest_known_body(normalised_surface)
+    return relative if relative is not None and relative.kind in RELATIVE_KINDS else None
 
 
 def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks,
@@ -281,6 +300,9 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
     body, stretch = stretched(normalised, found.height_map)
     graph = joint_graph(body)
     reread = from_behind(predict_landmarks(half_turned(graph))) if read_from_behind else predict_landmarks(graph)
+    reread = replace(reread, relative=landmarks.relative)
+    if reread.standard_kind != BIPED:
+        return landmarks, ()  # read again, the body is no sure biped: the first reading stands
     if found.big_head:
         note = (f"The head is big (neck at {found.neck / top:.0%} of the height, crotch at {found.crotch / top:.0%}) "
                 f"and the neck was first read higher: the landmarks were read again on the body mapped to a neck at "
@@ -289,8 +311,7 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
         note = (f"The legs are short (crotch at {found.crotch / top:.0%} of the height) and were first read as "
                 f"longer: the landmarks were read again on the body stretched to a crotch at "
                 f"{TYPICAL_CROTCH_SHARE:.0%}.")
-    return replace(reread, points=points_back(reread.points, stretch, found.height_map),
-                   relative=landmarks.relative), (note,)
+    return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
 
 
 def sure_standard_kind(landmarks: Landmarks) -> str | None:
@@ -385,7 +406,9 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tupl
     -------
     (kind, note): ``kind`` is ``"biped"``, ``"quadruped"`` or ``"free-form"``.
     ``auto`` takes the landmark network's kind when it is a biped or a
-    quadruped with probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`.
+    quadruped with probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`,
+    else the kind of the body's nearest known body when it gave one
+    (:data:`RELATIVE_KINDS`).
     """
     if template not in TEMPLATES:
         raise InputError(f"Unknown template '{template}': use one of {', '.join(TEMPLATES)}.")
@@ -399,7 +422,8 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tupl
         return guess, f"Template: standard {guess} skeleton; {seen}."
     kind = sure_standard_kind(votes.landmarks)
     if kind is not None:
-        return kind, f"Template: standard {kind} skeleton; {seen}, but {votes.landmarks.relative.note}."
+        return kind, (f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; "
+                      f"{votes.landmarks.relative.note}.")
     return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
                        "force one.")
 

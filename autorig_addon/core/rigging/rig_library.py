@@ -13,9 +13,10 @@ tail's root, family by family.
 The library (``trained/rig_library.npz``, built by ``train library``)
 holds, per training character, :data:`SURFACE_POINTS` points on its
 normalised surface and its kind, and for the bipeds and quadrupeds whose
-bone names give key joints, those key joints in that frame. A character the landmark network reads surely as one of
-those kinds finds the entry of its kind whose surface is nearest (symmetric
-Chamfer distance, in units of the largest side) when that distance is at
+bone names give key joints, those key joints in that frame. A character
+the landmark network reads surely as one of those kinds (or a biped by its
+nearest known body) finds the entry of its kind with key joints whose
+surface is nearest (symmetric Chamfer distance, in units of the largest side) when that distance is at
 most :data:`LIBRARY_DISTANCE`; a standard skeleton of that kind (not of a
 kind the user forces instead) takes the entry's key joints, mapped by the
 per-axis affine map between the two bounding boxes, and the landmark
@@ -67,7 +68,7 @@ LIBRARY_FILE = TRAINED_FOLDER / "rig_library.npz"
 #:
 #: The surfaces of two near-duplicates lie 0.007 to 0.01 apart.
 LIBRARY_DISTANCE = 0.025
-#: Points of each entry measured first (:func:`closest_rig`): a uniform
+#: Points of each entry measured first (:func:`_nearest_entry`): a uniform
 #: sample of the stored ones, which were drawn at random. Their mean
 #: distance estimates the entry's within about 6 % (one standard deviation).
 SCREEN_POINTS = 250
@@ -85,8 +86,8 @@ MEASURED_IN_FULL = 16
 #: A body the landmark network does not read surely as a biped or a
 #: quadruped is a biped when its nearest known body is one, at most this far
 #: away (:func:`nearest_known_body`). Chosen on the training characters
-#: alone (2026-12-06), each measured against the others of every family but
-#: its own: no fish, bird, quadruped or "other" body has a biped nearest
+#: alone (2026-12-06; ``scripts/tune_relative_kind.py``), each measured
+#: against the others of every family but its own: no fish, bird, quadruped or "other" body has a biped nearest
 #: within 0.053 (two snakes; Quaternius' blob Mushnubs at 0.07 and 0.087),
 #: while 167 of the 178 humanoids have one within 0.045 and 171 within
 #: 0.05. Not for quadrupeds: a velociraptor has a quadruped nearest, 0.044
@@ -96,7 +97,7 @@ RELATIVE_KIND_DISTANCE = 0.045
 
 @dataclass(frozen=True)
 class RigLibrary:
-    """The training characters' key joints, each with its surface.
+    """The training characters' surfaces and kinds, and the key joints of those that give them.
 
     Attributes
     ----------
@@ -210,7 +211,8 @@ def _nearest_entry(surface: Mesh, library: RigLibrary, entries: np.ndarray, limi
     """(index, distance) of the entry among ``entries`` whose surface is
     nearest ``surface`` when at most ``limit`` away, else None.
 
-    Measuring every entry in full would take about a second (162 bipeds).
+    Measuring every entry in full would take about a second (162 bipeds;
+    twice that over all 324 entries).
     Each entry is first measured one way on :data:`SCREEN_POINTS` of its
     points; then, in that order, at most :data:`MEASURED_IN_FULL` are
     measured in full, and none whose screened half-distance exceeds

@@ -87,7 +87,7 @@ class Landmarks:
     ----------
     points : dict mapping each name of :data:`LANDMARKS` to its (3,) position
     kind_probabilities : dict mapping each kind of :data:`BODY_KINDS` to its probability
-    closest_rig : ClosestRig, the known rig of the kind read whose key joints
+    closest_rig : ClosestRig, the known rig of the :attr:`standard_kind` whose key joints
         stand in for the network's (:mod:`.rig_library`); None when none lies near
     relative : KnownRelative, the nearest known body when it tells the kind the
         network does not read surely (:func:`.rig_library.nearest_known_body`); else None
