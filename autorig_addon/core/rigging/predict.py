@@ -234,8 +234,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         turned = landmarks
         rotation = HALF_TURN @ rotation
         transform, graph, solid, landmarks = read(rotation)
-        notes.append(f"The character faces away from -Y ({way.reason}); it was turned half a turn for the "
-                     "prediction, so its .L bones lie on its own left.")
+        notes.append(_turned_note(way.reason))
     if way.read_from_behind:
         landmarks = from_behind(turned)
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
@@ -251,8 +250,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
             transform, graph, solid, landmarks = read(rotation)
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
             relative = _relative_of_kind(normalised_surface)
-            notes.append("The character faces away from -Y (its toes point toward +Y); it was turned half a turn for "
-                         "the prediction, so its .L bones lie on its own left.")
+            notes.append(_turned_note("its toes point toward +Y"))
         elif toes is None or toes <= TOE_REACH_SURE:
             notes.append(front_untold_note(axis_name(-rotation[1]), biped=True))
     elif way.front_untold:
@@ -271,6 +269,12 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
                    surface=normalised_surface)
+
+
+def _turned_note(reason: str) -> str:
+    """The report's note for a character turned half a turn to face -Y, and why."""
+    return (f"The character faces away from -Y ({reason}); it was turned half a turn for the prediction, so its .L "
+            "bones lie on its own left.")
 
 
 def _relative_of_kind(normalised_surface: Mesh) -> KnownRelative | None:
