@@ -1,6 +1,7 @@
 """``python -m autorig_addon rig`` on a procedural biped written by the test (.glb and .blend)."""
 
 import json
+from dataclasses import replace
 
 import bpy
 import numpy as np
@@ -291,3 +292,29 @@ def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scen
                      parents=character.skeleton.parents).positions["hip.L"]
     np.testing.assert_allclose(np.array(armature.matrix_world @ thigh), hip, atol=1e-5)
 
+
+
+def test_the_summary_names_the_known_body_whose_kind_a_body_read_as_other_took(clean_scene, tmp_path, capsys,
+                                                                               monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+    character = generate_character(BIPED_SEED, "biped")
+    sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
+                                            character.weights)
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
+    # The landmark network's points, but the body read as "other", as Kenney's minis are.
+    network = predict.predict_landmarks
+    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: replace(
+        network(graph), kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9}))
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["body"], item["kind_from"]) == ("biped", "other", "procedural/biped_twin")
+    assert item["confidence"] == pytest.approx(0.9)
+    # Without the known body, the free-form skeleton, and no kind taken.
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: None)
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["kind_from"]) == ("free-form", None)

@@ -195,7 +195,9 @@ class RigResult:
     ``free-form``), ``body`` and ``confidence`` what the landmark network
     read the body as and how sure it was, ``key_joints_from`` the known rig
     whose key joints a standard skeleton took (``core.rigging.rig_library``;
-    empty when the landmark network's), ``rigify`` whether Rigify's control
+    empty when the landmark network's), ``kind_from`` the known body whose
+    kind the skeleton took when the network read none surely (empty
+    otherwise), ``rigify`` whether Rigify's control
     rig was generated, ``problems`` what the checks found in a poor skeleton
     kept on request."""
 
@@ -208,6 +210,7 @@ class RigResult:
     body: str = ""
     confidence: float = 0.0
     key_joints_from: str = ""
+    kind_from: str = ""
     rigify: bool = False
     problems: tuple = ()
 
@@ -459,6 +462,8 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
             copied = votes.landmarks.copied_for(result.template)
             result.key_joints_from = copied.name if copied is not None else ""
+            relative = votes.landmarks.relative
+            result.kind_from = relative.name if relative is not None and result.template == relative.kind else ""
         if plan.skin is not None:
             with restored_on_failure(bound):
                 if plan.replace:
