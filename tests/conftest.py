@@ -88,3 +88,17 @@ def one_torch_thread(request):
     torch.set_num_threads(1)
     yield
     torch.set_num_threads(threads)
+
+
+@pytest.fixture
+def read_as_other(monkeypatch):
+    """The landmark network's points, but every body read as "other" (as
+    Kenney's chibi minis are, up to 100 % sure): what a body's nearest known
+    body then tells is the only kind it has."""
+    from dataclasses import replace
+
+    from autorig_addon.core.rigging import predict
+
+    network = predict.predict_landmarks
+    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: replace(
+        network(graph), kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9}))

@@ -1,7 +1,6 @@
 """``python -m autorig_addon rig`` on a procedural biped written by the test (.glb and .blend)."""
 
 import json
-from dataclasses import replace
 
 import bpy
 import numpy as np
@@ -271,13 +270,20 @@ def test_rigid_parts_bind_each_piece_mostly_on_one_bone_wholly_to_it_unless_swit
     assert not np.allclose(smooth, expected, atol=1e-3)
 
 
-def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scene, tmp_path, capsys, monkeypatch):
-    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
-    save_biped(source)
+def known_twin(monkeypatch):
+    """The procedural biped saved by :func:`save_biped`, made the only known
+    rig (``procedural/biped_twin``) of the rig library; returns it."""
     character = generate_character(BIPED_SEED, "biped")
     sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
                                             character.weights)
     monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
+    return character
+
+
+def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scene, tmp_path, capsys, monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+    character = known_twin(monkeypatch)
 
     code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
 
@@ -293,19 +299,11 @@ def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scen
     np.testing.assert_allclose(np.array(armature.matrix_world @ thigh), hip, atol=1e-5)
 
 
-
 def test_the_summary_names_the_known_body_whose_kind_a_body_read_as_other_took(clean_scene, tmp_path, capsys,
-                                                                               monkeypatch):
+                                                                               monkeypatch, read_as_other):
     source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
     save_biped(source)
-    character = generate_character(BIPED_SEED, "biped")
-    sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
-                                            character.weights)
-    monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
-    # The landmark network's points, but the body read as "other", as Kenney's minis are.
-    network = predict.predict_landmarks
-    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: replace(
-        network(graph), kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9}))
+    known_twin(monkeypatch)
 
     code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
 

@@ -162,14 +162,6 @@ def test_the_nearest_known_body_of_any_kind_tells_its_kind(library, biped):
     assert nearest_known_body(stretched, library, limit=0.5 * distance) is None
 
 
-@pytest.fixture
-def read_as_other(monkeypatch):
-    """The landmark network's points, but every body read as "other" (as Kenney's minis are, up to 100 % sure)."""
-    network = predict.predict_landmarks
-    monkeypatch.setattr(predict, "predict_landmarks", lambda graph: replace(
-        network(graph), kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9}))
-
-
 def test_a_body_read_as_other_is_a_biped_when_its_nearest_known_body_is(library, biped, read_as_other, monkeypatch):
     character = biped[1]
     size = float(np.ptp(character.mesh.vertices, axis=0).max())
