@@ -45,7 +45,7 @@ from autorig_addon.core.skeleton.key_joints import KEY_JOINTS
 from autorig_addon.core.types import Mesh
 from autorig_addon.training.runs import held_out_names
 
-LIMITS = (0.0, 0.01, 0.015, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05)
+LIMITS = (0.0, 0.01, 0.015, 0.02, 0.025, 0.026, 0.03, 0.035, 0.04, 0.05)
 
 
 def near_duplicates(name: str) -> set:

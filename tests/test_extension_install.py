@@ -34,8 +34,10 @@ LINUX = "linux-x64"
 ADDON_MODULE = "bl_ext.user_default.autorig_addon"
 RESULT_PREFIX = "RESULT_JSON:"
 TESTS_DIRECTORY = os.path.dirname(os.path.abspath(__file__))
-#: The issue's target for the Linux zip, in bytes (torch made it 234 MB).
-LINUX_ZIP_SIZE_LIMIT = 60_000_000
+#: Issue 18 keeps every zip under 40 MB. The Windows zip is the largest: its
+#: scipy wheel is 1.26 MB larger than Linux's (docs/packaging.md), so the
+#: Linux zip built here must stay under 40 - 1.26 MB (torch made it 234 MB).
+LINUX_ZIP_SIZE_LIMIT = 38_700_000
 #: Seconds one Blender session may take (bpy start, unpacking, skinning).
 SESSION_TIMEOUT_SECONDS = 300
 #: Row sums of the written vertex groups (float32 in Blender) equal 1 to this.

@@ -37,6 +37,29 @@ def test_weights_and_metadata_round_trip(tmp_path):
     assert load_weights(path) == ({}, {})
 
 
+def test_weights_saved_at_half_precision_load_as_float32_rounded_to_it(tmp_path):
+    rng = np.random.default_rng(0)
+    weights = {
+        "mlp.linears.0.weight": rng.normal(size=(64, 32)).astype(np.float32),
+        "norm.running_var": np.array([2.5e6, 1.0], dtype=np.float32),  # beyond float16's 65504: kept whole
+        "norm.num_batches_tracked": np.asarray(12, dtype=np.int64),
+    }
+    full, half = str(tmp_path / "full.npz"), str(tmp_path / "half.npz")
+    save_weights(full, weights)
+    save_weights(half, weights, {"model": "tiny"}, half_precision=True)
+    loaded = load_weights(half)
+    assert loaded.metadata == {"model": "tiny"}
+    assert {name: array.dtype for name, array in loaded.weights.items()} == {
+        "mlp.linears.0.weight": np.float32, "norm.running_var": np.float32, "norm.num_batches_tracked": np.int64}
+    matrix = weights["mlp.linears.0.weight"]
+    assert np.array_equal(loaded.weights["mlp.linears.0.weight"], matrix.astype(np.float16).astype(np.float32))
+    assert 0 < np.abs(loaded.weights["mlp.linears.0.weight"] - matrix).max() <= 2.0 ** -11 * np.abs(matrix).max()
+    assert np.array_equal(loaded.weights["norm.running_var"], weights["norm.running_var"])
+    assert loaded.weights["norm.num_batches_tracked"] == 12
+    # 2,048 numbers at two bytes instead of four: the file is about half as large.
+    assert os.path.getsize(half) < 0.6 * os.path.getsize(full)
+
+
 def test_bad_names_and_values_are_refused_before_writing(tmp_path):
     path = str(tmp_path / "model.npz")
     with pytest.raises(ValueError, match="Invalid weight name '__format_version__'"):

@@ -290,7 +290,7 @@ def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scen
     assert code == 0
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["key_joints_from"]) == ("biped", "procedural/biped_twin")
-    assert ("Key joints copied from the closest known rig, procedural/biped_twin (surfaces 0.000 of the largest side "
+    assert ("Key joints copied from the closest known rig, procedural/biped_twin (surfaces 0.002 of the largest side "
             "apart).") in item["notes"]
     armature, _ = the_armature_and_mesh(out)
     thigh = armature.data.bones["thigh.L"].head_local

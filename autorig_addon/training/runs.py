@@ -143,12 +143,12 @@ def procedural_samples(count: int) -> list[CharacterSample]:
 
 
 def write_weights(spec: NetworkSpec, weights: dict, record: FitRecord, output: Optional[Path]) -> Path:
-    """Save the kept weights with the run's record (and the software that
-    made them) where the extension reads them, or to ``output``."""
+    """Save the kept weights at half precision with the run's record (and the
+    software that made them) where the extension reads them, or to ``output``."""
     spec.check_weights(weights, f"the trained {spec.name} network")
     destination = Path(output) if output else spec.weights_file
     destination.parent.mkdir(parents=True, exist_ok=True)
     metadata = {**record.metadata(), "torch_version": torch.__version__, "python": sys.version.split()[0]}
-    save_weights(str(destination), weights, metadata)
+    save_weights(str(destination), weights, metadata, half_precision=True)
     forget_shipped_weights()
     return destination
