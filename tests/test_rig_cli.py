@@ -13,6 +13,7 @@ from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict, rig_library
 from autorig_addon.core.skeleton.key_joints import key_joints
+from autorig_addon.core.types import Mesh
 from blender_fixtures import make_armature, mesh_object, reset_scene
 
 #: A symmetric procedural biped (1,866 vertices).
@@ -270,11 +271,14 @@ def test_rigid_parts_bind_each_piece_mostly_on_one_bone_wholly_to_it_unless_swit
     assert not np.allclose(smooth, expected, atol=1e-3)
 
 
-def known_twin(monkeypatch):
+def known_twin(monkeypatch, widened: float = 1.0):
     """The procedural biped saved by :func:`save_biped`, made the only known
-    rig (``procedural/biped_twin``) of the rig library; returns it."""
+    rig (``procedural/biped_twin``) of the rig library; returns it. ``widened``:
+    the known body is that many times as wide (1.8: 0.033 from the biped, a
+    relative beyond the known-rig limit but within the kind's)."""
     character = generate_character(BIPED_SEED, "biped")
-    sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
+    known = Mesh(character.mesh.vertices * np.array([widened, 1.0, 1.0]), character.mesh.triangles)
+    sample = CharacterSample.from_character("procedural/biped_twin", "biped", known, character.skeleton,
                                             character.weights)
     monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
     return character
@@ -285,7 +289,9 @@ def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scen
     save_biped(source)
     character = known_twin(monkeypatch)
 
-    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+    # Auto would give the twin's whole rig (test below); the standard biped takes its key joints.
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--template", "biped",
+                                "--quiet"], capsys)
 
     assert code == 0
     (item,) = json.loads(stdout)["succeeded"]
@@ -299,17 +305,44 @@ def test_the_summary_names_the_known_rig_whose_key_joints_were_copied(clean_scen
     np.testing.assert_allclose(np.array(armature.matrix_world @ thigh), hip, atol=1e-5)
 
 
+def test_a_body_near_a_known_one_gets_its_rig_fitted_and_bound(clean_scene, tmp_path, capsys, monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+    character = known_twin(monkeypatch)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["rig_from"], item["bones"]) == ("known rig", "procedural/biped_twin", 26)
+    assert item["notes"][0].startswith("Template: the rig of the closest known character, procedural/biped_twin")
+    armature, mesh = the_armature_and_mesh(out)
+    artist = character.skeleton.deform_subset()
+    assert sorted(bone.name for bone in armature.data.bones) == sorted(artist.names)
+    for name in ("thigh.L", "hand.R", "spine.006"):
+        np.testing.assert_allclose(np.array(armature.matrix_world @ armature.data.bones[name].head_local),
+                                   artist.joints[artist.names.index(name)], atol=2e-3)
+    # Bound: every vertex weighted, to the twin's bones.
+    groups = {group.name for group in mesh.vertex_groups}
+    assert groups <= set(artist.names) and all(len(vertex.groups) for vertex in mesh.data.vertices)
+    # Engine names need the standard skeleton: asked for, it is built instead.
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--names", "mixamo", "--quiet"], capsys)
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["rig_from"]) == ("biped", None)
+
+
 def test_the_summary_names_the_known_body_whose_kind_a_body_read_as_other_took(clean_scene, tmp_path, capsys,
                                                                                monkeypatch, read_as_other):
     source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
     save_biped(source)
-    known_twin(monkeypatch)
+    known_twin(monkeypatch, widened=1.8)
 
     code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
 
     assert code == 0
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["body"], item["kind_from"]) == ("biped", "other", "procedural/biped_twin")
+    assert item["rig_from"] is None
     assert item["confidence"] == pytest.approx(0.9)
     # Without the known body, the free-form skeleton, and no kind taken.
     monkeypatch.setattr(rig_library, "shipped_library", lambda: None)

@@ -27,7 +27,7 @@ from autorig_addon.core.rigging.rig_library import (
     twin_mirror_error,
 )
 from autorig_addon.core.skeleton.key_joints import KEY_JOINTS, key_joints
-from autorig_addon.core.types import Mesh
+from autorig_addon.core.types import Mesh, Skeleton
 
 
 def procedural(kind: str, seed: int = 0):
@@ -167,9 +167,10 @@ def test_a_character_whose_relative_is_known_gets_its_artist_key_joints(library,
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
     votes = predict.predict_votes(character.mesh)
     assert votes.landmarks.closest_rig.name == "procedural/biped_0"
-    # Its own surface, 0.002 away: the library keeps 1,000 of the 2,000 points the body is sampled at.
+    # Its own surface, 0.002 away: the library keeps 1,000 of the 2,000 points the body is sampled at. (Auto gives
+    # the known rig itself: the standard skeleton, asked for, takes its key joints.)
     assert ("Key joints copied from the closest known rig, procedural/biped_0 (surfaces 0.002 of the largest side "
-            "apart).") in predict.template_notes(votes)
+            "apart).") in predict.template_notes(votes, "biped")
     copied_errors = key_joint_errors(predict.skeleton_from_votes(votes, template="biped"), character.skeleton, size)
     assert max(copied_errors.values()) < 1e-6
     # A quadruped forced on this biped is built on the network's key joints, not on the biped's rig.
@@ -197,15 +198,16 @@ def test_a_body_read_as_other_is_a_biped_when_its_nearest_known_body_is(library,
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
     votes = predict.predict_votes(character.mesh)
     assert votes.landmarks.kind == "other" and votes.landmarks.relative.name == "procedural/biped_0"
-    kind, note = predict.chosen_template(votes)
+    # Without its known rig (which Auto would give it, test below), a standard biped.
+    kind, note = predict.chosen_template(votes, known_rig=False)
     assert kind == "biped"
     assert note == ("Template: standard biped skeleton; the landmark network reads the body as other (90% sure), not "
                     "surely a biped or quadruped; the closest known body, procedural/biped_0 (0.002 of the largest "
                     "side away), is a biped.")
     # Its key joints are its relative's, as for a body the network reads as a biped.
     assert any(note.startswith("Key joints copied from the closest known rig, procedural/biped_0")
-               for note in predict.template_notes(votes))
-    skeleton = predict.skeleton_from_votes(votes, fingers=False)
+               for note in predict.template_notes(votes, known_rig=False))
+    skeleton = predict.skeleton_from_votes(votes, fingers=False, known_rig=False)
     assert len(skeleton.names) == 22
     assert max(key_joint_errors(skeleton, character.skeleton, size).values()) < 1e-6
     # With only a quadruped and a fish known, nothing tells its kind: the free-form skeleton.
@@ -222,7 +224,9 @@ def test_a_quadruped_nearest_gives_no_kind(library, read_as_other, monkeypatch):
     assert nearest_known_body(normalised_copy(procedural("quadruped")[0], [1.0, 1.0, 1.0]), library).kind == "quadruped"
     votes = predict.predict_votes(quadruped.mesh)
     assert votes.landmarks.relative is None
-    assert predict.chosen_template(votes)[0] == "free-form"
+    assert predict.chosen_template(votes, known_rig=False)[0] == "free-form"
+    # Its known rig, though, lies near: Auto gives that rig, whatever the kind.
+    assert predict.chosen_template(votes)[0] == "known rig" and votes.known_rig.name == "procedural/quadruped_0"
 
 
 def test_a_biped_by_its_nearest_known_body_facing_plus_y_is_turned_by_its_toes(library, biped, read_as_other,
@@ -235,6 +239,59 @@ def test_a_biped_by_its_nearest_known_body_facing_plus_y_is_turned_by_its_toes(l
     assert "The character faces away from -Y (its toes point toward +Y); it was turned half a turn for the " \
            "prediction, so its .L bones lie on its own left." in votes.notes
     assert not any(note.startswith("Which way the character faces could not be told") for note in votes.notes)
-    skeleton = predict.skeleton_from_votes(votes, fingers=False)
-    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
-    assert found["shoulder.L"][0] < 0.0 < found["shoulder.R"][0]
+    # The standard biped and the known rig alike have their .L bones on its own left.
+    for allowed in (False, True):
+        skeleton = predict.skeleton_from_votes(votes, fingers=False, known_rig=allowed)
+        found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+        assert found["shoulder.L"][0] < 0.0 < found["shoulder.R"][0]
+
+
+def test_a_body_near_a_known_body_gets_that_rig_fitted_by_default(library, biped, monkeypatch):
+    character = biped[1]
+    artist = character.skeleton
+    size = float(np.ptp(character.mesh.vertices, axis=0).max())
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    votes = predict.predict_votes(character.mesh)
+    kind, note = predict.chosen_template(votes)
+    assert kind == "known rig"
+    assert note.startswith("Template: the rig of the closest known character, procedural/biped_0 (surfaces 0.002 of the "
+                           "largest side apart), fitted to this body: its artist's 26 bones and names; the landmark "
+                           "network reads the body as biped")
+    skeleton = predict.skeleton_from_votes(votes)
+    # Its own rig: its artist's 26 deform bones (not the root and heels, which deform nothing and join nothing), with
+    # their names and parents, each joint where the artist put it (the library keeps half precision: 0.0005 of the
+    # largest side).
+    artist = artist.deform_subset()
+    assert sorted(skeleton.names) == sorted(artist.names) and len(skeleton.names) == 26 and skeleton.deform.all()
+    order = [artist.names.index(name) for name in skeleton.names]
+    np.testing.assert_allclose(skeleton.joints, artist.joints[order], atol=1e-3 * size)
+    assert [skeleton.names[parent] if parent >= 0 else None for parent in skeleton.parents] == [
+        artist.names[artist.parents[index]] if artist.parents[index] >= 0 else None for index in order]
+    # A standard skeleton when asked for, when the known rig is not allowed (Rigify), or with engine names.
+    for keywords in ({"template": "biped"}, {"known_rig": False}, {"names": "mixamo"}):
+        standard = predict.skeleton_from_votes(votes, fingers=False, **keywords)
+        assert len(standard.names) == 22 and standard.deform.all(), keywords
+    assert "mixamorig:Hips" in predict.skeleton_from_votes(votes, names="mixamo").names
+    # A body farther from every known one than the limit gets no known rig.
+    stretched = Mesh(character.mesh.vertices * np.array([1.8, 1.0, 1.0]), character.mesh.triangles)
+    far = predict.predict_votes(stretched)
+    assert far.known_rig is None and predict.chosen_template(far)[0] == "biped"
+
+
+def test_a_rig_that_is_several_trees_is_joined_into_one():
+    # Two deform chains hanging from a root that deforms nothing: the root joins them and stays non-deforming.
+    joints = np.array([[0, 0, 0], [0, 0, 1], [0, 0, 2], [1, 0, 1], [1, 0, 2], [0, 0, 3]], dtype=np.float64)
+    rooted = Skeleton(joints[:5], np.array([-1, 0, 1, 0, 3]), ("root", "a", "a.001", "b", "b.001"),
+                      deform=np.array([False, True, True, True, True]))
+    joined = rig_library._one_tree_rig(rooted)
+    assert joined.names == ("root", "a", "a.001", "b", "b.001") and joined.deform.tolist() == [False] + [True] * 4
+    # A weighted bone that nothing joins (a head apart from the body) hangs from the nearest joint of the rest;
+    # a bone above it that deforms nothing is left out.
+    apart = Skeleton(joints, np.array([-1, 0, 1, 0, 3, -1]), ("root", "a", "a.001", "b", "b.001", "head"),
+                     deform=np.array([True, True, True, True, True, True]))
+    joined = rig_library._one_tree_rig(apart)
+    assert dict(zip(joined.names, (joined.names[p] if p >= 0 else None for p in joined.parents)))["head"] == "a.001"
+    assert int(np.sum(joined.parents < 0)) == 1
+    # Nothing deforms: no rig.
+    assert rig_library._one_tree_rig(Skeleton(joints[:2], np.array([-1, 0]), ("x", "y"),
+                                              deform=np.array([False, False]))) is None

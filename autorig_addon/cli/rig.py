@@ -137,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
                    "meshes": [obj.name for obj in plan.meshes], "skin": args.skin, "template": result.template,
                    "body": result.body, "confidence": round(result.confidence, 3),
                    "key_joints_from": result.key_joints_from or None, "kind_from": result.kind_from or None,
+                   "rig_from": result.rig_from or None,
                    "rigify": result.rigify,
                    "problems": list(result.problems)}
         if removed:

@@ -52,6 +52,7 @@ from ...core.rigging.predict import (
     template_notes,
 )
 from ...core.rigging.props import carried_props, prop_notes, rigid_props
+from ...core.rigging.rig_library import KNOWN_RIG
 from ...core.rigging.standard_skeleton import FREE_FORM
 from ...core.skeleton.checks import skeleton_extent
 from ...core.skeleton.name_presets import DEFAULT_PRESET
@@ -191,13 +192,14 @@ class RigPlan:
 class RigResult:
     """What a run built: the armature, its skeleton, the notes of the
     prediction and, when it bound the meshes, the skin plan and weights;
-    ``template`` is the skeleton built (``biped``, ``quadruped`` or
-    ``free-form``), ``body`` and ``confidence`` what the landmark network
+    ``template`` is the skeleton built (``biped``, ``quadruped``,
+    ``free-form`` or ``known rig``), ``body`` and ``confidence`` what the landmark network
     read the body as and how sure it was, ``key_joints_from`` the known rig
     whose key joints a standard skeleton took (``core.rigging.rig_library``;
     empty when the landmark network's), ``kind_from`` the known body whose
     kind the skeleton took when the network read none surely (empty
-    otherwise), ``rigify`` whether Rigify's control
+    otherwise), ``rig_from`` the known body whose whole rig was fitted
+    (``known rig``; empty otherwise), ``rigify`` whether Rigify's control
     rig was generated, ``problems`` what the checks found in a poor skeleton
     kept on request."""
 
@@ -211,6 +213,7 @@ class RigResult:
     confidence: float = 0.0
     key_joints_from: str = ""
     kind_from: str = ""
+    rig_from: str = ""
     rigify: bool = False
     problems: tuple = ()
 
@@ -429,7 +432,9 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     """
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
     votes = yield lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share))
-    skeleton = skeleton_from_votes(votes, **plan.settings.keywords())
+    # Rigify's control rig is built on a standard skeleton, never on a known body's rig.
+    known_rig = not plan.rigify and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
+    skeleton = skeleton_from_votes(votes, **plan.settings.keywords(), known_rig=known_rig)
     problems = skeleton_quality(votes, skeleton)
     if problems and not plan.keep_poor:
         raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
@@ -443,7 +448,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
         template = plan.settings.template or DEFAULT_TEMPLATE
         fingers = DEFAULT_FINGERS if plan.settings.fingers is None else plan.settings.fingers
         naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
-        notes = (*plan.notes, *votes.notes, *template_notes(votes, template, skeleton, fingers),
+        notes = (*plan.notes, *votes.notes, *template_notes(votes, template, skeleton, fingers, known_rig),
                  *((naming,) if naming else ()), *(f"poor result kept: {problem}" for problem in problems))
         target = armature
         rig = None
@@ -457,13 +462,16 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 created += [rig, metarig]
                 target, notes = rig, (*notes, *rigify_notes)
         result = RigResult(target, convert.read_skeleton(target) if rig is not None else skeleton, notes,
-                           template=chosen_template(votes, template)[0], rigify=rig is not None, problems=problems)
+                           template=chosen_template(votes, template, known_rig)[0], rigify=rig is not None,
+                           problems=problems)
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
             copied = votes.landmarks.copied_for(result.template)
             result.key_joints_from = copied.name if copied is not None else ""
             relative = votes.landmarks.relative
             result.kind_from = relative.name if relative is not None and result.template == relative.kind else ""
+        if result.template == KNOWN_RIG:
+            result.rig_from = votes.known_rig.name
         if plan.skin is not None:
             with restored_on_failure(bound):
                 if plan.replace:

@@ -31,10 +31,12 @@ RIG_OPTIONS = option_table(
            "skeleton is symmetric with .L/.R names"),
     Option("template", str, predict.DEFAULT_TEMPLATE, "Template",
            "Which skeleton to build: a standard biped or quadruped (Rigify's metarig layout and names), the "
-           "free-form skeleton of the joint votes, or whichever the shape looks like",
+           "free-form skeleton of the joint votes, or whichever the shape looks like (a known character's rig when "
+           "its body is nearly this one)",
            choices=(
-               Choice(standard_skeleton.AUTO, "Auto", "A standard biped or quadruped skeleton when the shape "
-                      "clearly is one, otherwise the free-form skeleton"),
+               Choice(standard_skeleton.AUTO, "Auto", "The rig of a known character whose body is nearly this "
+                      "one, fitted to it; else a standard biped or quadruped skeleton when the shape clearly is one; "
+                      "else the free-form skeleton"),
                Choice(standard_skeleton.BIPED, "Biped", "A standard humanoid skeleton (Rigify's human metarig)"),
                Choice(standard_skeleton.QUADRUPED, "Quadruped",
                       "A standard four-legged skeleton (Rigify's quadruped metarig)"),

@@ -47,7 +47,7 @@ from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
 from .quality import skeleton_problems
-from .rig_library import KnownRelative, closest_rig, nearest_known_body
+from .rig_library import KNOWN_RIG, KnownRelative, KnownRig, closest_rig, fitted_rig, nearest_known_body
 from .role_names import role_names
 from .standard_skeleton import (
     AUTO,
@@ -135,6 +135,8 @@ class JointVotes:
     proxy_vertices : (n, 3) float64, the normalised proxy's vertices (None with ``landmarks``)
     surface : Mesh, the full-resolution surface in the normalised frame, where
         a standard biped's fingers are looked for (None: no fingers)
+    known_rig : KnownRig, the rig of a known body near this one, fitted to it
+        (:func:`.rig_library.fitted_rig`), which the Auto template gives; None when none is near
     """
 
     points: np.ndarray
@@ -146,6 +148,7 @@ class JointVotes:
     landmarks: Landmarks | None = None
     proxy_vertices: np.ndarray | None = None
     surface: Mesh | None = None
+    known_rig: KnownRig | None = None
 
 
 def require_enough_faces(mesh: Mesh) -> None:
@@ -241,7 +244,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append(f"{facing_note} reads more surely as a {landmarks.kind} from behind: its landmarks were read "
                      "from behind and turned back.")
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
-    relative = None if sure_standard_kind(landmarks) else _relative_of_kind(normalised_surface)
+    nearest = None if sure_standard_kind(landmarks) else nearest_known_body(normalised_surface)
+    relative = _of_relative_kind(nearest)
     if way.front_untold and relative is not None:
         # Read as neither kind either way round, the body is a biped by its nearest known body: its toes tell its front.
         toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
@@ -249,7 +253,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
             rotation = HALF_TURN @ rotation
             transform, graph, solid, landmarks = read(rotation)
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
-            relative = _relative_of_kind(normalised_surface)
+            nearest = nearest_known_body(normalised_surface)
+            relative = _of_relative_kind(nearest)
             notes.append(_turned_note("its toes point toward +Y"))
         elif toes is None or toes <= TOE_REACH_SURE:
             notes.append(front_untold_note(axis_name(-rotation[1]), biped=True))
@@ -262,13 +267,15 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     notes += proportion_notes
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
+    near = landmarks.closest_rig or nearest
+    known = fitted_rig(near.name, near.distance, normalised_surface) if near is not None else None
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
-                   surface=normalised_surface)
+                   surface=normalised_surface, known_rig=known)
 
 
 def _turned_note(reason: str) -> str:
@@ -277,12 +284,11 @@ def _turned_note(reason: str) -> str:
             "bones lie on its own left.")
 
 
-def _relative_of_kind(normalised_surface: Mesh) -> KnownRelative | None:
+def _of_relative_kind(nearest: KnownRelative | None) -> KnownRelative | None:
     """The nearest known body of a body the landmark network does not read
     surely (:func:`.rig_library.nearest_known_body`), when it is of a kind of
     :data:`RELATIVE_KINDS`; else None."""
-    relative = nearest_known_body(normalised_surface)
-    return relative if relative is not None and relative.kind in RELATIVE_KINDS else None
+    return nearest if nearest is not None and nearest.kind in RELATIVE_KINDS else None
 
 
 def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks,
@@ -386,14 +392,14 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
 
 
 def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton: Skeleton | None = None,
-                   fingers: bool = DEFAULT_FINGERS) -> tuple:
+                   fingers: bool = DEFAULT_FINGERS, known_rig: bool = True) -> tuple:
     """The report's notes on the template: which one and why
     (:func:`chosen_template`), then what looks wrong with a standard
     skeleton (:func:`.standard_skeleton.landmark_warnings`), and, for a
     standard biped ``skeleton`` asked with ``fingers`` that has none, that
-    its hands' fingers are not separable."""
-    kind, note = chosen_template(votes, template)
-    if kind == FREE_FORM or votes.solid is None:
+    its hands' fingers are not separable. ``known_rig``: as for :func:`chosen_template`."""
+    kind, note = chosen_template(votes, template, known_rig)
+    if kind in (FREE_FORM, KNOWN_RIG) or votes.solid is None:
         return (note,)
     fingerless = (kind == BIPED and fingers and skeleton is not None and votes.surface is not None
                   and not has_fingers(skeleton.names))
@@ -403,15 +409,18 @@ def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton
             *((NOT_SEPARABLE_NOTE,) if fingerless else ()))
 
 
-def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tuple[str, str]:
+def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_rig: bool = True) -> tuple[str, str]:
     """The skeleton ``template`` gives on these votes, and a note saying why.
 
     Returns
     -------
-    (kind, note): ``kind`` is ``"biped"``, ``"quadruped"`` or ``"free-form"``.
-    ``auto`` takes the landmark network's kind when it is a biped or a
-    quadruped with probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`,
-    else the kind of the body's nearest known body when it gave one
+    (kind, note): ``kind`` is ``"biped"``, ``"quadruped"``, ``"free-form"``
+    or ``"known rig"``. ``auto`` gives the rig of a known body near this one
+    when there is one (:attr:`JointVotes.known_rig`) and ``known_rig`` allows
+    it (Rigify's control rig and engine names need a standard skeleton);
+    else the landmark network's kind when it is a biped or a quadruped with
+    probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`, else
+    the kind of the body's nearest known body when it gave one
     (:data:`RELATIVE_KINDS`).
     """
     if template not in TEMPLATES:
@@ -422,6 +431,9 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE) -> tupl
     seen = f"the landmark network reads the body as {guess} ({confidence:.0%} sure)"
     if template != AUTO:
         return template, f"Template: standard {template} skeleton, as asked; {seen}."
+    if known_rig and votes.known_rig is not None:
+        return KNOWN_RIG, (f"{votes.known_rig.note}; {seen}. Choose the Biped or Quadruped template for a standard "
+                           "skeleton (and Rigify's control rig).")
     if votes.landmarks.read_surely:
         return guess, f"Template: standard {guess} skeleton; {seen}."
     kind = sure_standard_kind(votes.landmarks)
@@ -486,7 +498,8 @@ def connect_joints(joints: np.ndarray, mirror: np.ndarray, solid: SolidDepth) ->
 def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWIDTH,
                         density_threshold: float = DEFAULT_DENSITY_THRESHOLD,
                         symmetry: bool = DEFAULT_SYMMETRY, template: str = DEFAULT_TEMPLATE,
-                        names: str = DEFAULT_PRESET, fingers: bool = DEFAULT_FINGERS) -> Skeleton:
+                        names: str = DEFAULT_PRESET, fingers: bool = DEFAULT_FINGERS,
+                        known_rig: bool = True) -> Skeleton:
     """The skeleton of the votes at a level of detail, in the mesh's space.
 
     Parameters
@@ -501,17 +514,24 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
         that is not a standard biped keeps Rigify's names (:func:`naming_note` says so)
     fingers : bool, give a standard biped fingers when both hands have
         separable ones in ``votes.surface`` (:mod:`.fingers`)
+    known_rig : bool, let ``auto`` give a known body's rig (:func:`chosen_template`);
+        names other than Rigify's need the standard skeleton, so they do not
 
     Returns
     -------
-    Skeleton, every bone deforming, parents first, names unique.
+    Skeleton, parents first, names unique; every bone deforming but those of a
+    known rig that only join its deform bones into one tree.
     """
-    kind, _ = chosen_template(votes, template)
+    kind, _ = chosen_template(votes, template, known_rig and names == DEFAULT_PRESET)
+    to_mesh = np.linalg.inv(votes.transform)
+    if kind == KNOWN_RIG:
+        rig = votes.known_rig.skeleton
+        return Skeleton(apply_transform(rig.joints, to_mesh), rig.parents, rig.names,
+                        apply_transform(rig.tails, to_mesh), rig.deform)
     if kind != FREE_FORM:
         nearly_symmetric = symmetry and mirror_error(votes.proxy_vertices, 0) <= NEAR_SYMMETRIC_ERROR
         skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric,
                                      votes.surface if fingers else None)
-        to_mesh = np.linalg.inv(votes.transform)
         return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
                         preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))
     if not MIN_BANDWIDTH <= bandwidth <= MAX_BANDWIDTH:
@@ -530,7 +550,6 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     mirror = np.where(mirror[order] >= 0, position[np.maximum(mirror[order], 0)], -1)
     bone_names = preset_names(role_names(joints, parents, mirror), names)[0]
     tails = leaf_tails_inside(joints, parents, derived_tails(joints, parents), votes.solid)
-    to_mesh = np.linalg.inv(votes.transform)
     return Skeleton(apply_transform(joints, to_mesh), parents, bone_names, apply_transform(tails, to_mesh))
 
 
@@ -571,8 +590,9 @@ def leaf_tails_inside(joints: np.ndarray, parents: np.ndarray, tails: np.ndarray
 def predict_skeleton(mesh: Mesh, *, bandwidth: float = DEFAULT_BANDWIDTH,
                      density_threshold: float = DEFAULT_DENSITY_THRESHOLD, symmetry: bool = DEFAULT_SYMMETRY,
                      template: str = DEFAULT_TEMPLATE, names: str = DEFAULT_PRESET,
-                     fingers: bool = DEFAULT_FINGERS, progress: ProgressCallback | None = None) -> Skeleton:
+                     fingers: bool = DEFAULT_FINGERS, known_rig: bool = True,
+                     progress: ProgressCallback | None = None) -> Skeleton:
     """:func:`predict_votes` then :func:`skeleton_from_votes`."""
     votes = predict_votes(mesh, progress)
     return skeleton_from_votes(votes, bandwidth=bandwidth, density_threshold=density_threshold, symmetry=symmetry,
-                               template=template, names=names, fingers=fingers)
+                               template=template, names=names, fingers=fingers, known_rig=known_rig)

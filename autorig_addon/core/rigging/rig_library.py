@@ -26,6 +26,13 @@ neck). Run on a training character, the search finds that character itself.
 The same surfaces also say what kind of body a character is when the
 landmark network cannot (:func:`nearest_known_body`): Kenney's chibi minis,
 read as "other", lie nearest KayKit's chibi ranger.
+
+Each entry also keeps its artist's whole rig (the deform bones, names and
+parents) when it is one tree: a character whose nearest known body lies
+within :data:`LIBRARY_DISTANCE` gets that rig fitted to it by default
+(:func:`fitted_rig`, :data:`KNOWN_RIG`), as the closest-character baseline
+does but only where a relative is near: Quaternius' casual woman takes the
+rig her pack's suited woman shares, so the pack's animations play on her.
 """
 
 from __future__ import annotations
@@ -38,8 +45,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..evaluation.skeleton_metrics import symmetric_chamfer
+from ..skeleton.hierarchy import ancestors, parents_first_order, reindexed_parents, subset_parents
 from ..skeleton.key_joints import KEY_JOINT_TWINS, KEY_JOINTS
-from ..types import Mesh
+from ..types import Mesh, Skeleton
 from .nearest_character import SURFACE_POINTS, box_map, surface_points
 from .networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from .networks.trained import TRAINED_FOLDER
@@ -117,6 +125,9 @@ MEASURED_IN_FULL = 16
 #: check gives the same counts (no other body with a biped nearest within
 #: 0.05, 167 humanoids within 0.045).
 RELATIVE_KIND_DISTANCE = 0.046
+#: What the *Auto* template gives a body whose nearest known body lies
+#: within :data:`LIBRARY_DISTANCE` and has a rig (:func:`fitted_rig`).
+KNOWN_RIG = "known rig"
 
 
 @dataclass(frozen=True)
@@ -131,6 +142,12 @@ class RigLibrary:
     key_joints : (n, k, 3) float32, in :data:`..skeleton.key_joints.KEY_JOINTS` order
     known : (n, k) bool, which key joints each rig gives (none: the entry only tells a kind)
     boxes : (n, 2, 3) float32, each normalised mesh's bounding box (lowest, highest corner)
+    rig_counts : (n,) int64, bones of each entry's rig (0: none kept, its deform bones are not one tree)
+    rig_joints, rig_tails : (sum of rig_counts, 3) float32, the rigs' heads and tails, entry after entry
+    rig_parents : (sum of rig_counts,) int64, each bone's parent within its rig (-1: the root), parents first
+    rig_names : (sum of rig_counts,) str, the artists' bone names
+    rig_deform : (sum of rig_counts,) bool, whether each bone deforms (those that only join the
+        deform bones into one tree do not)
     """
 
     names: np.ndarray
@@ -139,23 +156,43 @@ class RigLibrary:
     key_joints: np.ndarray
     known: np.ndarray
     boxes: np.ndarray
+    rig_counts: np.ndarray
+    rig_joints: np.ndarray
+    rig_tails: np.ndarray
+    rig_parents: np.ndarray
+    rig_names: np.ndarray
+    rig_deform: np.ndarray
 
     def save(self, path: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
+        # The rigs at half precision: 0.0005 of the largest side at worst.
         np.savez_compressed(path, names=self.names, kinds=self.kinds, steps=_to_steps(self.points, self.boxes),
                             key_joints=self.key_joints.astype(np.float32), known=self.known,
-                            boxes=self.boxes.astype(np.float32))
+                            boxes=self.boxes.astype(np.float32), rig_counts=self.rig_counts.astype(np.int32),
+                            rig_joints=self.rig_joints.astype(np.float16), rig_tails=self.rig_tails.astype(np.float16),
+                            rig_parents=self.rig_parents.astype(np.int16), rig_names=self.rig_names,
+                            rig_deform=self.rig_deform)
+
+    def rig_rows(self, entry: int) -> slice:
+        """The rows of entry ``entry``'s rig in the ``rig_*`` arrays."""
+        start = int(self.rig_counts[:entry].sum())
+        return slice(start, start + int(self.rig_counts[entry]))
 
     def subset(self, keep: np.ndarray) -> "RigLibrary":
         """The entries where ``keep`` (n,) bool is true."""
+        rows = np.repeat(np.asarray(keep, dtype=bool), self.rig_counts)
         return RigLibrary(self.names[keep], self.kinds[keep], self.points[keep], self.key_joints[keep],
-                          self.known[keep], self.boxes[keep])
+                          self.known[keep], self.boxes[keep], self.rig_counts[keep], self.rig_joints[rows],
+                          self.rig_tails[rows], self.rig_parents[rows], self.rig_names[rows],
+                          self.rig_deform[rows])
 
     @classmethod
     def load(cls, path: Path) -> "RigLibrary":
         with np.load(path, allow_pickle=False) as data:
             return cls(data["names"], data["kinds"], _from_steps(data["steps"], data["boxes"]), data["key_joints"],
-                       data["known"], data["boxes"])
+                       data["known"], data["boxes"], data["rig_counts"].astype(np.int64),
+                       data["rig_joints"].astype(np.float32), data["rig_tails"].astype(np.float32),
+                       data["rig_parents"].astype(np.int64), data["rig_names"], data["rig_deform"])
 
 
 def _box_sides(boxes: np.ndarray) -> np.ndarray:
@@ -228,6 +265,23 @@ class KnownRelative:
         return f"the closest known body, {self.name} ({self.distance:.3f} of the largest side away), is a {self.kind}"
 
 
+@dataclass(frozen=True)
+class KnownRig:
+    """The rig of a known body near a character (:func:`fitted_rig`): the
+    entry's name, kind and surface distance, and its artist's deform bones
+    mapped onto the character (normalised frame)."""
+
+    name: str
+    kind: str
+    distance: float
+    skeleton: Skeleton
+
+    @property
+    def note(self) -> str:
+        return (f"Template: the rig of the closest known character, {self.name} (surfaces {self.distance:.3f} of the "
+                f"largest side apart), fitted to this body: its artist's {len(self.skeleton.names)} bones and names")
+
+
 @lru_cache(maxsize=1)
 def shipped_library() -> RigLibrary | None:
     """The shipped library, read once; None when the file is absent (a checkout before ``train library``)."""
@@ -252,6 +306,28 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
                      np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
     points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
     return ClosestRig(str(library.names[best]), distance, points)
+
+
+def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | None = None) -> KnownRig | None:
+    """The rig of the entry ``name`` (found ``distance`` from ``surface``,
+    normalised frame) mapped by the per-axis affine map between the two
+    bounding boxes, as its key joints are (:func:`closest_rig`); None when
+    that is farther than :data:`LIBRARY_DISTANCE` or the entry keeps no rig."""
+    library = shipped_library() if library is None else library
+    if library is None or distance > LIBRARY_DISTANCE:
+        return None
+    found = np.flatnonzero(library.names == name)
+    if not len(found) or not library.rig_counts[found[0]]:
+        return None
+    entry = int(found[0])
+    rows = library.rig_rows(entry)
+    source = library.boxes[entry].astype(np.float64)
+    target = np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)])
+    joints, tails = (box_map(points[rows].astype(np.float64), source, target)
+                     for points in (library.rig_joints, library.rig_tails))
+    skeleton = Skeleton(joints, library.rig_parents[rows].copy(), tuple(str(bone) for bone in library.rig_names[rows]),
+                        tails, library.rig_deform[rows].copy())
+    return KnownRig(name, str(library.kinds[entry]), distance, skeleton)
 
 
 def nearest_known_body(surface: Mesh, library: RigLibrary | None = None,
@@ -327,7 +403,7 @@ def build_rig_library(samples: list) -> RigLibrary:
     characters rest in a pose, and one 0 A.D. elephant's left legs are
     rigged elsewhere than its body's, while a standard skeleton is built
     symmetric."""
-    names, kinds, points, key_joints, known, boxes = [], [], [], [], [], []
+    names, kinds, points, key_joints, known, boxes, rigs = [], [], [], [], [], [], []
     for sample in sorted(samples, key=lambda sample: sample.name):
         targets, known_joints, kind = sample_landmarks(sample)
         copied = (BODY_KINDS[kind] in STANDARD_KINDS and known_joints.any()
@@ -338,6 +414,59 @@ def build_rig_library(samples: list) -> RigLibrary:
         key_joints.append(targets if copied else np.zeros_like(targets))
         known.append(known_joints > 0 if copied else np.zeros(len(known_joints), dtype=bool))
         boxes.append([sample.vertices.min(axis=0), sample.vertices.max(axis=0)])
+        rigs.append(_one_tree_rig(sample.skeleton))
+    kept = [rig for rig in rigs if rig is not None]
     return RigLibrary(np.array(names), np.array(kinds), np.array(points, dtype=np.float32),
                       np.array(key_joints, dtype=np.float32), np.array(known, dtype=bool),
-                      np.array(boxes, dtype=np.float32))
+                      np.array(boxes, dtype=np.float32),
+                      np.array([len(rig.names) if rig is not None else 0 for rig in rigs], dtype=np.int64),
+                      np.concatenate([rig.joints for rig in kept] or [np.zeros((0, 3))]).astype(np.float32),
+                      np.concatenate([rig.tails for rig in kept] or [np.zeros((0, 3))]).astype(np.float32),
+                      np.concatenate([rig.parents for rig in kept] or [np.zeros(0)]).astype(np.int64),
+                      np.array([name for rig in kept for name in rig.names], dtype=str),
+                      np.concatenate([rig.deform for rig in kept] or [np.zeros(0)]).astype(bool))
+
+
+def _one_tree_rig(skeleton: Skeleton) -> Skeleton | None:
+    """An artist's rig as one tree (a rig handed to an animator must be one),
+    parents first: its deform bones and, when they hang from bones that
+    deform nothing (Quaternius' modular men from a ``Root``), the chains
+    joining them, which stay non-deforming. Deform bones that nothing joins
+    (YellowDragon's head, IK bones an artist weighted) hang from the nearest
+    joint of the largest tree. None when no bone deforms."""
+    parents = np.asarray(skeleton.parents, dtype=np.int64)
+    deform = np.asarray(skeleton.deform, dtype=bool)
+    if not deform.any():
+        return None
+    tops = [int(joint) for joint in np.flatnonzero(deform) if not deform[ancestors(parents, int(joint))].any()]
+    keep = deform.copy()
+    paths = [[top, *ancestors(parents, top)] for top in tops]
+    shared = set(paths[0]).intersection(*map(set, paths[1:]))
+    if len(tops) > 1 and shared:
+        meeting = next(joint for joint in paths[0] if joint in shared)  # the lowest joint above every top
+        for path in paths:
+            keep[path[: path.index(meeting) + 1]] = True
+    rows = np.flatnonzero(keep)
+    joints = skeleton.joints[rows]
+    kept_parents = _joined_trees(subset_parents(parents, keep), joints)
+    order = parents_first_order(kept_parents)
+    return Skeleton(joints[order], reindexed_parents(kept_parents, order),
+                    tuple(skeleton.names[rows[index]] for index in order), skeleton.tails[rows][order],
+                    deform[rows][order])
+
+
+def _joined_trees(parents: np.ndarray, joints: np.ndarray) -> np.ndarray:
+    """``parents`` with every tree but the largest hung, by its root, from
+    the nearest joint of the trees already joined, largest first."""
+    parents = parents.copy()
+    roots = np.flatnonzero(parents < 0)
+    if len(roots) < 2:
+        return parents
+    tree = np.array([([joint, *ancestors(parents, joint)])[-1] for joint in range(len(parents))])
+    roots = sorted(roots.tolist(), key=lambda root: -int(np.sum(tree == root)))
+    joined = tree == roots[0]
+    for root in roots[1:]:
+        candidates = np.flatnonzero(joined)
+        parents[root] = candidates[np.argmin(np.linalg.norm(joints[candidates] - joints[root], axis=1))]
+        joined |= tree == root
+    return parents
