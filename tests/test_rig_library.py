@@ -254,9 +254,9 @@ def test_a_body_near_a_known_body_gets_that_rig_fitted_by_default(library, biped
     votes = predict.predict_votes(character.mesh)
     kind, note = predict.chosen_template(votes)
     assert kind == "known rig"
-    assert note.startswith("Template: the rig of the closest known character, procedural/biped_0 (surfaces 0.002 of the "
-                           "largest side apart), fitted to this body: its artist's 26 bones and names; the landmark "
-                           "network reads the body as biped")
+    assert note.startswith("Template: the rig of the closest known character, procedural/biped_0 (surfaces 0.002 of "
+                           "the largest side apart), fitted to this body: its artist's 26 bones and names; the "
+                           "landmark network reads the body as biped")
     skeleton = predict.skeleton_from_votes(votes)
     # Its own rig: its artist's 26 deform bones (not the root and heels, which deform nothing and join nothing), with
     # their names and parents, each joint where the artist put it (the library keeps half precision: 0.0005 of the
