@@ -13,7 +13,7 @@ from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict, rig_library
 from autorig_addon.core.skeleton.key_joints import key_joints
-from autorig_addon.core.types import Mesh
+from autorig_addon.core.types import Mesh, Skeleton
 from blender_fixtures import make_armature, mesh_object, reset_scene
 
 #: A symmetric procedural biped (1,866 vertices).
@@ -329,6 +329,65 @@ def test_a_body_near_a_known_one_gets_its_rig_fitted_and_bound(clean_scene, tmp_
     code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--names", "mixamo", "--quiet"], capsys)
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["rig_from"]) == ("biped", None)
+
+
+def known_rig_edited(monkeypatch, edit) -> object:
+    """The procedural biped's twin made the only known rig, its artist's
+    skeleton changed by ``edit(joints, deform, names)`` (the arrays edited in
+    place); returns the character."""
+    character = generate_character(BIPED_SEED, "biped")
+    skeleton = character.skeleton
+    joints, deform = skeleton.joints.copy(), skeleton.deform.copy()
+    edit(joints, deform, skeleton.names)
+    edited = Skeleton(joints, skeleton.parents, skeleton.names, None, deform)
+    sample = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, edited,
+                                            character.weights)
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([sample]))
+    return character
+
+
+def test_a_known_rig_whose_legs_hang_from_a_bone_that_deforms_nothing_keeps_it_unweighted(clean_scene, tmp_path,
+                                                                                        capsys, monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+
+    def hips_deform_nothing(joints, deform, names):
+        deform[names.index("spine")] = False  # the legs and the spine hang from it
+
+    known_rig_edited(monkeypatch, hips_deform_nothing)
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["bones"], item["problems"]) == ("known rig", 26, [])
+    armature, mesh = the_armature_and_mesh(out)
+    bones = armature.data.bones
+    assert not bones["spine"].use_deform and bones["thigh.L"].parent.name == "spine"
+    assert sum(bone.use_deform for bone in bones) == 25
+    # Bound to the 25 deforming bones only: no vertex on the hips bone, every vertex weighted.
+    assert "spine" not in {group.name for group in mesh.vertex_groups}
+    assert all(len(vertex.groups) for vertex in mesh.data.vertices)
+
+
+def test_a_known_rig_that_sits_poorly_on_the_body_gives_way_to_the_standard_skeleton(clean_scene, tmp_path, capsys,
+                                                                                    monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+
+    def hair_in_the_air(joints, deform, names):
+        joints[names.index("hair.002")] += [0.0, 0.0, 1.0]  # a metre above the head
+
+    known_rig_edited(monkeypatch, hair_in_the_air)
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    assert (item["template"], item["rig_from"], item["problems"]) == ("biped", None, [])
+    assert any(note.startswith("the rig of the closest known character, procedural/biped_twin, looks poor on this "
+                               "body (") and note.endswith("): the skeleton was built without it")
+               for note in item["notes"])
+    armature, _ = the_armature_and_mesh(out)
+    assert "hair.002" not in armature.data.bones and "neck" in armature.data.bones  # the standard biped's
 
 
 def test_the_summary_names_the_known_body_whose_kind_a_body_read_as_other_took(clean_scene, tmp_path, capsys,

@@ -285,13 +285,30 @@ def test_a_rig_that_is_several_trees_is_joined_into_one():
                       deform=np.array([False, True, True, True, True]))
     joined = rig_library._one_tree_rig(rooted)
     assert joined.names == ("root", "a", "a.001", "b", "b.001") and joined.deform.tolist() == [False] + [True] * 4
-    # A weighted bone that nothing joins (a head apart from the body) hangs from the nearest joint of the rest;
-    # a bone above it that deforms nothing is left out.
+    assert joined.parents.tolist() == [-1, 0, 1, 0, 3]
+    # The same, with a weighted head that nothing joins (a tree of its own in the artist's rig): the root still joins
+    # the chains, and the head hangs from the nearest joint of that tree, the top of chain a.
     apart = Skeleton(joints, np.array([-1, 0, 1, 0, 3, -1]), ("root", "a", "a.001", "b", "b.001", "head"),
-                     deform=np.array([True, True, True, True, True, True]))
+                     deform=np.array([False, True, True, True, True, True]))
     joined = rig_library._one_tree_rig(apart)
-    assert dict(zip(joined.names, (joined.names[p] if p >= 0 else None for p in joined.parents)))["head"] == "a.001"
-    assert int(np.sum(joined.parents < 0)) == 1
+    parent_of = dict(zip(joined.names, (joined.names[p] if p >= 0 else None for p in joined.parents)))
+    assert parent_of == {"root": None, "a": "root", "a.001": "a", "b": "root", "b.001": "b", "head": "a.001"}
+    assert dict(zip(joined.names, joined.deform.tolist()))["root"] is False
     # Nothing deforms: no rig.
     assert rig_library._one_tree_rig(Skeleton(joints[:2], np.array([-1, 0]), ("x", "y"),
                                               deform=np.array([False, False]))) is None
+
+
+def test_every_entry_keeps_its_own_rig_through_saving_and_subsets(library, tmp_path):
+    library.save(tmp_path / "library.npz")
+    loaded = RigLibrary.load(tmp_path / "library.npz")
+    for built_from in (loaded, loaded.subset(library.kinds != "biped")):
+        for entry, name in enumerate(built_from.names):
+            original = int(np.flatnonzero(library.names == name)[0])
+            rows, kept = built_from.rig_rows(entry), library.rig_rows(original)
+            assert built_from.rig_names[rows].tolist() == library.rig_names[kept].tolist()
+            assert built_from.rig_parents[rows].tolist() == library.rig_parents[kept].tolist()
+            assert built_from.rig_deform[rows].tolist() == library.rig_deform[kept].tolist()
+            np.testing.assert_allclose(built_from.rig_joints[rows], library.rig_joints[kept], atol=1e-3)
+    # The biped's, the fish's and the quadruped's rigs, one after the other: 26, 30 and 33 bones.
+    assert library.rig_counts.tolist() == [26, 30, 33] and len(library.rig_names) == 89

@@ -19,6 +19,7 @@ from autorig_addon.core.errors import Cancelled
 from autorig_addon.core.geometry.outward_faces import inward_faces_note
 from autorig_addon.core.rigging import predict
 from blender_fixtures import (
+    BIPED_SEED,
     RecordingWindowManager,
     RecordingWorkspace,
     add_biped,
@@ -117,6 +118,28 @@ def test_bandwidth_reclusters_the_same_armature_live(biped):
     order = [built.names.index(name) for name in expected.names]
     np.testing.assert_allclose(built.joints[order], expected.joints, atol=1e-5)
     assert rig.live_note(bpy.context) == ("Live: the settings update 'Biped_rig'", "ARMATURE_DATA")
+
+
+def test_a_known_rig_stays_live_and_gives_way_to_a_standard_biped_for_engine_names(biped, monkeypatch):
+    # The biped's own procedural twin is the only known rig: Predict Skeleton gives its rig.
+    from autorig_addon.core.dataset.sample import CharacterSample
+    from autorig_addon.core.procedural import generate_character
+    from autorig_addon.core.rigging import rig_library
+
+    character = generate_character(BIPED_SEED, "biped")
+    twin = CharacterSample.from_character("procedural/biped_twin", "biped", character.mesh, character.skeleton,
+                                          character.weights)
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: rig_library.build_rig_library([twin]))
+    assert bpy.ops.autorig.predict_skeleton() == {"FINISHED"}
+    (armature,) = armatures()
+    artist = sorted(character.skeleton.deform_subset().names)
+    assert sorted(bone.name for bone in armature.data.bones) == artist
+    # Mixamo's names need the standard biped: the live armature becomes one, and the known rig again without them.
+    bpy.context.scene.autorig.rig_names = "MIXAMO"
+    assert "mixamorig:Hips" in armature.data.bones and len(armature.data.bones) == 22
+    bpy.context.scene.autorig.rig_names = "RIGIFY"
+    assert sorted(bone.name for bone in armature.data.bones) == artist
+    assert armatures() == [armature]
 
 
 @pytest.mark.parametrize("bandwidth", [predict.MIN_BANDWIDTH, predict.MAX_BANDWIDTH])

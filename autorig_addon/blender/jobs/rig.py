@@ -220,11 +220,14 @@ class RigResult:
 
 @dataclass
 class _Prediction:
-    """A cached prediction: the network outputs and the skeleton the
-    armature had when last built from them (world space, as read back)."""
+    """A cached prediction: the network outputs, the skeleton the armature
+    had when last built from them (world space, as read back), and whether
+    *Auto* may give a known body's rig there (not after it looked poor on the
+    body; engine names, a setting, turn it off while they are chosen)."""
 
     votes: JointVotes
     built: Skeleton
+    known_rig: bool = True
 
 
 _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
@@ -407,11 +410,12 @@ def _require_not_flat(meshes, mesh: Mesh) -> None:
     raise InputError(message + " Nothing was built.")
 
 
-def _remember(armature, votes: JointVotes) -> None:
-    """Cache ``votes`` for live re-clustering of ``armature`` (marked with a new token)."""
+def _remember(armature, votes: JointVotes, known_rig: bool = True) -> None:
+    """Cache ``votes`` for live re-clustering of ``armature`` (marked with a
+    new token), and whether *Auto* may give it a known body's rig there."""
     token = uuid.uuid4().hex
     armature[PREDICTED_PROPERTY] = token
-    _PREDICTIONS[token] = _Prediction(votes, convert.read_skeleton(armature))
+    _PREDICTIONS[token] = _Prediction(votes, convert.read_skeleton(armature), known_rig)
     while len(_PREDICTIONS) > MAX_CACHED_PREDICTIONS:
         _PREDICTIONS.popitem(last=False)
 
@@ -432,10 +436,20 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     """
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
     votes = yield lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share))
-    # Rigify's control rig is built on a standard skeleton, never on a known body's rig.
-    known_rig = not plan.rigify and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
+    # Rigify's control rig is built on a standard skeleton, never on a known body's rig; nor are engine names given.
+    known_rig_allowed = not plan.rigify
+    known_rig = known_rig_allowed and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
+    template = plan.settings.template or DEFAULT_TEMPLATE
     skeleton = skeleton_from_votes(votes, **plan.settings.keywords(), known_rig=known_rig)
     problems = skeleton_quality(votes, skeleton)
+    known_rig_note = ()
+    if problems and known_rig and chosen_template(votes, template)[0] == KNOWN_RIG:
+        # A known rig that sits poorly on this body: the skeleton the body gets without one.
+        known_rig_note = (f"the rig of the closest known character, {votes.known_rig.name}, looks poor on this body "
+                          f"({'; '.join(problems)}): the skeleton was built without it",)
+        known_rig = known_rig_allowed = False
+        skeleton = skeleton_from_votes(votes, **plan.settings.keywords(), known_rig=known_rig)
+        problems = skeleton_quality(votes, skeleton)
     if problems and not plan.keep_poor:
         raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
                          "Template, or keep it anyway with Keep Poor Result (--keep-poor).")
@@ -445,11 +459,11 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     created = [armature]
     try:
         armature.show_in_front = True  # the bones are inside the body
-        template = plan.settings.template or DEFAULT_TEMPLATE
         fingers = DEFAULT_FINGERS if plan.settings.fingers is None else plan.settings.fingers
         naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
         notes = (*plan.notes, *votes.notes, *template_notes(votes, template, skeleton, fingers, known_rig),
-                 *((naming,) if naming else ()), *(f"poor result kept: {problem}" for problem in problems))
+                 *known_rig_note, *((naming,) if naming else ()),
+                 *(f"poor result kept: {problem}" for problem in problems))
         target = armature
         rig = None
         if plan.rigify:
@@ -487,7 +501,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights
         if remember and rig is None:
-            _remember(armature, votes)
+            _remember(armature, votes, known_rig_allowed)
     except BaseException:
         for obj in reversed(created):
             if obj.name in bpy.data.objects:
@@ -624,7 +638,7 @@ def update_live_prediction(context, settings: RigSettings) -> object:
     if armature is None:
         return None
     prediction = _prediction_of(armature)
-    skeleton = skeleton_from_votes(prediction.votes, **settings.keywords())
+    skeleton = skeleton_from_votes(prediction.votes, **settings.keywords(), known_rig=prediction.known_rig)
     rebuild_armature(armature, skeleton, context)
     prediction.built = convert.read_skeleton(armature)
     _PREDICTIONS.move_to_end(armature[PREDICTED_PROPERTY])

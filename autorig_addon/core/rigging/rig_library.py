@@ -28,11 +28,13 @@ landmark network cannot (:func:`nearest_known_body`): Kenney's chibi minis,
 read as "other", lie nearest KayKit's chibi ranger.
 
 Each entry also keeps its artist's whole rig (the deform bones, names and
-parents) when it is one tree: a character whose nearest known body lies
-within :data:`LIBRARY_DISTANCE` gets that rig fitted to it by default
-(:func:`fitted_rig`, :data:`KNOWN_RIG`), as the closest-character baseline
-does but only where a relative is near: Quaternius' casual woman takes the
-rig her pack's suited woman shares, so the pack's animations play on her.
+parents, made one tree by :func:`_one_tree_rig`): a character with a known
+relative within :data:`LIBRARY_DISTANCE` gets that rig fitted to it by
+default (:func:`fitted_rig`, :data:`KNOWN_RIG`), as the closest-character
+baseline does but only where a relative is near: Quaternius' casual woman
+takes the joints, names and hierarchy of her pack's suited woman (not the
+bones' rolls, which the library does not keep), so animations made for the
+pack retarget onto her by name.
 """
 
 from __future__ import annotations
@@ -86,7 +88,7 @@ LIBRARY_DISTANCE = 0.026
 #: Points each entry keeps (:func:`library_points`): the most spread of the
 #: :data:`SURFACE_POINTS` drawn on its surface. Half of them, stored as one
 #: byte per coordinate, keep the extension's zip under issue 18's 40 MB
-#: (the library was 3.6 MB at 2,000 points in half precision, 0.7 MB so).
+#: (the library's points took 3.6 MB at 2,000 a body in half precision, 0.98 MB so).
 #: Measured on the nearest three entries of every training character, the
 #: Chamfer distance to a body sampled at :data:`SURFACE_POINTS` points grows
 #: by 0.0011 of the largest side (0.0002 more than the full set's rounding
@@ -125,8 +127,10 @@ MEASURED_IN_FULL = 16
 #: check gives the same counts (no other body with a biped nearest within
 #: 0.05, 167 humanoids within 0.045).
 RELATIVE_KIND_DISTANCE = 0.046
-#: What the *Auto* template gives a body whose nearest known body lies
-#: within :data:`LIBRARY_DISTANCE` and has a rig (:func:`fitted_rig`).
+#: What the *Auto* template gives a body with a known relative within
+#: :data:`LIBRARY_DISTANCE` (:func:`fitted_rig`): for a body read as a
+#: biped or quadruped, the entry whose key joints it copies
+#: (:func:`closest_rig`); for another, its nearest known body.
 KNOWN_RIG = "known rig"
 
 
@@ -142,7 +146,7 @@ class RigLibrary:
     key_joints : (n, k, 3) float32, in :data:`..skeleton.key_joints.KEY_JOINTS` order
     known : (n, k) bool, which key joints each rig gives (none: the entry only tells a kind)
     boxes : (n, 2, 3) float32, each normalised mesh's bounding box (lowest, highest corner)
-    rig_counts : (n,) int64, bones of each entry's rig (0: none kept, its deform bones are not one tree)
+    rig_counts : (n,) int64, bones of each entry's rig (:func:`_one_tree_rig`; 0: none, no bone deforms)
     rig_joints, rig_tails : (sum of rig_counts, 3) float32, the rigs' heads and tails, entry after entry
     rig_parents : (sum of rig_counts,) int64, each bone's parent within its rig (-1: the root), parents first
     rig_names : (sum of rig_counts,) str, the artists' bone names
@@ -268,8 +272,8 @@ class KnownRelative:
 @dataclass(frozen=True)
 class KnownRig:
     """The rig of a known body near a character (:func:`fitted_rig`): the
-    entry's name, kind and surface distance, and its artist's deform bones
-    mapped onto the character (normalised frame)."""
+    entry's name, kind and surface distance, and its artist's rig
+    (:func:`_one_tree_rig`) mapped onto the character (normalised frame)."""
 
     name: str
     kind: str
@@ -431,7 +435,7 @@ def _one_tree_rig(skeleton: Skeleton) -> Skeleton | None:
     """An artist's rig as one tree (a rig handed to an animator must be one),
     parents first: its deform bones and, when they hang from bones that
     deform nothing (Quaternius' modular men from a ``Root``), the chains
-    joining them, which stay non-deforming. Deform bones that nothing joins
+    joining them, which stay non-deforming. Trees that nothing joins
     (YellowDragon's head, IK bones an artist weighted) hang from the nearest
     joint of the largest tree. None when no bone deforms."""
     parents = np.asarray(skeleton.parents, dtype=np.int64)
@@ -441,10 +445,13 @@ def _one_tree_rig(skeleton: Skeleton) -> Skeleton | None:
     tops = [int(joint) for joint in np.flatnonzero(deform) if not deform[ancestors(parents, int(joint))].any()]
     keep = deform.copy()
     paths = [[top, *ancestors(parents, top)] for top in tops]
-    shared = set(paths[0]).intersection(*map(set, paths[1:]))
-    if len(tops) > 1 and shared:
-        meeting = next(joint for joint in paths[0] if joint in shared)  # the lowest joint above every top
-        for path in paths:
+    for root in {path[-1] for path in paths}:  # the tops under one root of the artist's tree are joined there
+        joined = [path for path in paths if path[-1] == root]
+        if len(joined) < 2:
+            continue
+        shared = set(joined[0]).intersection(*map(set, joined[1:]))
+        meeting = next(joint for joint in joined[0] if joint in shared)  # the lowest joint above each of them
+        for path in joined:
             keep[path[: path.index(meeting) + 1]] = True
     rows = np.flatnonzero(keep)
     joints = skeleton.joints[rows]
