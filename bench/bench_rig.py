@@ -17,8 +17,10 @@ weights files), each step runs ``--repeat`` times:
   (what the level-of-detail slider re-runs: clustering, connectivity,
   names), with the joint count;
 * ``predict_skeleton``: both, as *Predict Skeleton* runs them with the
-  default template (the standard skeleton when the landmark network reads a
-  biped or quadruped), and with the free-form template;
+  default template (a known character's rig when the body lies near one,
+  else the standard skeleton when the landmark network reads a biped or
+  quadruped), with the default template but no known rig (the standard
+  skeleton), and with the free-form template;
 * on ``5k`` only, the auto-rig core path: ``predict_skeleton`` then
   ``core.skinning.methods.skin_weights`` with the default method, as
   *Auto-Rig* runs them (without Blender's armature and vertex-group writes);
@@ -101,7 +103,7 @@ def measured(function, seconds: list, peaks: dict, key: str):
 def run_size(folder: str, size: str, repeat: int) -> dict:
     mesh, _, _ = character(folder, size)
     steps = (["predict_votes"] + [f"skeleton_from_votes free-form h={h:g}" for h in BANDWIDTHS]
-             + ["predict_skeleton", "predict_skeleton free-form"])
+             + ["predict_skeleton", "predict_skeleton without known rigs", "predict_skeleton free-form"])
     rigify_step = f"Auto-Rig with Rigify in Blender ({DEFAULT_SKIN_METHOD} skin)"
     if size in AUTO_RIG_SIZES:
         steps += [f"auto-rig (predict_skeleton + skin_weights {DEFAULT_SKIN_METHOD})", rigify_step]
@@ -117,8 +119,11 @@ def run_size(folder: str, size: str, repeat: int) -> dict:
             skeleton = measured(lambda: predict.skeleton_from_votes(votes, bandwidth=bandwidth, template="free-form"),
                                 seconds[step], peaks, step)
             joints[step] = skeleton.bone_count
-        for step, template in (("predict_skeleton", "auto"), ("predict_skeleton free-form", "free-form")):
-            skeleton = measured(lambda: predict.predict_skeleton(mesh, template=template), seconds[step], peaks, step)
+        for step, template, known_rig in (("predict_skeleton", "auto", True),
+                                          ("predict_skeleton without known rigs", "auto", False),
+                                          ("predict_skeleton free-form", "free-form", True)):
+            skeleton = measured(lambda: predict.predict_skeleton(mesh, template=template, known_rig=known_rig),
+                                seconds[step], peaks, step)
             joints[step] = skeleton.bone_count
         if size in AUTO_RIG_SIZES:
             step = steps[-2]
