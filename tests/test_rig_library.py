@@ -312,3 +312,24 @@ def test_every_entry_keeps_its_own_rig_through_saving_and_subsets(library, tmp_p
             np.testing.assert_allclose(built_from.rig_joints[rows], library.rig_joints[kept], atol=1e-3)
     # The biped's, the fish's and the quadruped's rigs, one after the other: 26, 30 and 33 bones.
     assert library.rig_counts.tolist() == [26, 30, 33] and len(library.rig_names) == 89
+
+
+def test_a_known_rig_the_checks_find_poor_gives_way_to_the_skeleton_without_it(biped, monkeypatch):
+    sample, character = biped
+    joints = sample.joints.copy()
+    joints[sample.names.index("hair.002"), 2] += 1.0  # a bone tip a whole body height above the head
+    library = build_rig_library([replace(sample, joints=joints)])
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
+    votes = predict.predict_votes(character.mesh)
+    assert predict.chosen_template(votes)[0] == "known rig"
+    poor = predict.skeleton_quality(votes, predict.skeleton_from_votes(votes))
+    assert poor and any("hair.001" in problem for problem in poor)
+    checked = predict.checked_skeleton(votes)
+    assert (checked.problems, checked.known_rig) == ((), False)
+    assert len(checked.skeleton.names) == 22 and "neck" in checked.skeleton.names  # the standard biped (mitten hands)
+    assert checked.notes == (f"The rig of the closest known character, procedural/biped_0, looks poor on this body "
+                             f"({'; '.join(poor)}): the skeleton was built without it.",)
+    # A sound known rig is kept.
+    monkeypatch.setattr(rig_library, "shipped_library", lambda: build_rig_library([sample]))
+    sound = predict.checked_skeleton(predict.predict_votes(character.mesh))
+    assert sound.known_rig and sound.notes == () and "hair.002" in sound.skeleton.names

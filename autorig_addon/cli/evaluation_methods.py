@@ -219,11 +219,12 @@ def _nearest_character(mesh) -> RigPrediction:
 
 
 def _rignet_skeleton(mesh, template: str = "auto") -> RigPrediction:
-    from ..core.rigging.predict import predict_votes, skeleton_from_votes, template_notes
+    from ..core.rigging.predict import checked_skeleton, predict_votes, template_notes
 
     votes = predict_votes(mesh)
-    skeleton = skeleton_from_votes(votes, template=template)
-    return RigPrediction(skeleton, (*votes.notes, *template_notes(votes, template)))
+    checked = checked_skeleton(votes, template=template)  # as Auto-Rig builds it
+    return RigPrediction(checked.skeleton, (*votes.notes, *template_notes(votes, template, known_rig=checked.known_rig),
+                                            *checked.notes))
 
 
 def _closest_point_transfer(source, source_weights, target):

@@ -44,11 +44,11 @@ from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
     JointVotes,
+    checked_skeleton,
     chosen_template,
     naming_note,
     predict_votes,
     skeleton_from_votes,
-    skeleton_quality,
     template_notes,
 )
 from ...core.rigging.props import carried_props, prop_notes, rigid_props
@@ -436,20 +436,12 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     """
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
     votes = yield lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share))
-    # Rigify's control rig is built on a standard skeleton, never on a known body's rig; nor are engine names given.
-    known_rig_allowed = not plan.rigify
-    known_rig = known_rig_allowed and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
+    # Rigify's control rig is built on a standard skeleton, never on a known body's rig.
+    checked = checked_skeleton(votes, known_rig=not plan.rigify, **plan.settings.keywords())
+    skeleton, problems = checked.skeleton, checked.problems
+    # Engine names are given to a standard skeleton only (skeleton_from_votes reads them so).
+    known_rig = checked.known_rig and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
     template = plan.settings.template or DEFAULT_TEMPLATE
-    skeleton = skeleton_from_votes(votes, **plan.settings.keywords(), known_rig=known_rig)
-    problems = skeleton_quality(votes, skeleton)
-    known_rig_note = ()
-    if problems and known_rig and chosen_template(votes, template)[0] == KNOWN_RIG:
-        # A known rig that sits poorly on this body: the skeleton the body gets without one.
-        known_rig_note = (f"the rig of the closest known character, {votes.known_rig.name}, looks poor on this body "
-                          f"({'; '.join(problems)}): the skeleton was built without it",)
-        known_rig = known_rig_allowed = False
-        skeleton = skeleton_from_votes(votes, **plan.settings.keywords(), known_rig=known_rig)
-        problems = skeleton_quality(votes, skeleton)
     if problems and not plan.keep_poor:
         raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
                          "Template, or keep it anyway with Keep Poor Result (--keep-poor).")
@@ -462,7 +454,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
         fingers = DEFAULT_FINGERS if plan.settings.fingers is None else plan.settings.fingers
         naming = naming_note(skeleton, plan.settings.names or DEFAULT_PRESET)
         notes = (*plan.notes, *votes.notes, *template_notes(votes, template, skeleton, fingers, known_rig),
-                 *known_rig_note, *((naming,) if naming else ()),
+                 *checked.notes, *((naming,) if naming else ()),
                  *(f"poor result kept: {problem}" for problem in problems))
         target = armature
         rig = None
@@ -501,7 +493,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 write_skin(skin_plan, weights)
             result.skin_plan, result.weights = skin_plan, weights
         if remember and rig is None:
-            _remember(armature, votes, known_rig_allowed)
+            _remember(armature, votes, checked.known_rig)
     except BaseException:
         for obj in reversed(created):
             if obj.name in bpy.data.objects:

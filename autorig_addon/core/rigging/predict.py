@@ -23,6 +23,7 @@ turned for the network; so is one turned by any angle, lying or upside down
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -389,6 +390,35 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
     normalised = Skeleton(apply_transform(skeleton.joints, votes.transform), skeleton.parents, skeleton.names,
                           apply_transform(skeleton.tails, votes.transform))
     return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices)
+
+
+class CheckedSkeleton(NamedTuple):
+    """A skeleton (:func:`checked_skeleton`), what the checks found wrong in
+    it, whether a known rig was still allowed when it was built, and a note
+    when a poor known rig gave way."""
+
+    skeleton: Skeleton
+    problems: tuple
+    known_rig: bool
+    notes: tuple
+
+
+def checked_skeleton(votes: JointVotes, known_rig: bool = True, **settings) -> CheckedSkeleton:
+    """:func:`skeleton_from_votes` with ``settings`` (its keywords) and
+    ``known_rig``, and what :func:`skeleton_quality` finds wrong in it. A
+    known body's rig that the checks find poor on this body (a bone far
+    outside it) gives way to the skeleton the body gets without one, with a
+    note saying why; ``known_rig`` is then False in the result, so that
+    building again (the level-of-detail slider) does not bring it back."""
+    template, names = settings.get("template", DEFAULT_TEMPLATE), settings.get("names", DEFAULT_PRESET)
+    skeleton = skeleton_from_votes(votes, **settings, known_rig=known_rig)
+    problems = skeleton_quality(votes, skeleton)
+    if not problems or chosen_template(votes, template, known_rig and names == DEFAULT_PRESET)[0] != KNOWN_RIG:
+        return CheckedSkeleton(skeleton, problems, known_rig, ())
+    note = (f"The rig of the closest known character, {votes.known_rig.name}, looks poor on this body "
+            f"({'; '.join(problems)}): the skeleton was built without it.")
+    skeleton = skeleton_from_votes(votes, **settings, known_rig=False)
+    return CheckedSkeleton(skeleton, skeleton_quality(votes, skeleton), False, (note,))
 
 
 def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton: Skeleton | None = None,
