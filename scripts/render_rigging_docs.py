@@ -6,8 +6,9 @@ Usage (from the repo root)::
 
 1. For each character (default: four validation characters of
    data_split.json), side by side: the artist's deform skeleton, the
-   skeleton predicted with the defaults (the standard skeleton of the kind
-   the landmark network reads) and the free-form skeleton at
+   skeleton predicted with the defaults (a known relative's rig, then also
+   the skeleton without it; else the standard skeleton of the kind the
+   landmark network reads) and the free-form skeleton at
    ``core.rigging.predict.DEFAULT_BANDWIDTH`` -> ``rigging_<Name>.png``.
 2. For one character (``--lod-character``, default the knight): the
    free-form prediction at :data:`BANDWIDTHS`, the network run once
@@ -35,6 +36,7 @@ from mathutils import Vector
 from autorig_addon.blender.characters import load_character
 from autorig_addon.core.geometry.bounding_box import largest_side
 from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, chosen_template, predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.rig_library import KNOWN_RIG
 from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from docs_render import (
     CHARACTERS,
@@ -149,10 +151,16 @@ def render_comparison(path: str, out_dir: str) -> None:
     name = os.path.splitext(os.path.basename(path))[0]
     print(f"{name}: artist {artist.bone_count} deform bones, default ({kind}) {standard.bone_count} bones, "
           f"free-form {free_form.bone_count} joints; {note} {' '.join(votes.notes)}")
-    render_panels(character, [(f"artist\n{artist.bone_count} deform bones", artist),
-                              (f"predicted ({kind} template)\n{standard.bone_count} bones", standard),
-                              (f"free-form, bandwidth {DEFAULT_BANDWIDTH}\n{free_form.bone_count} joints", free_form)],
-                  os.path.join(out_dir, f"rigging_{name}.png"), out_dir)
+    if kind == KNOWN_RIG:  # four panels, short labels: the skeleton without the relative's rig beside it
+        unknown = skeleton_from_votes(votes, known_rig=False)
+        panels = [(f"artist\n{artist.bone_count} bones", artist), (f"known rig\n{standard.bone_count} bones", standard),
+                  (f"{chosen_template(votes, known_rig=False)[0]}\n{unknown.bone_count} bones", unknown),
+                  (f"free-form\n{free_form.bone_count} joints", free_form)]
+    else:
+        panels = [(f"artist\n{artist.bone_count} deform bones", artist),
+                  (f"predicted ({kind} template)\n{standard.bone_count} bones", standard),
+                  (f"free-form, bandwidth {DEFAULT_BANDWIDTH}\n{free_form.bone_count} joints", free_form)]
+    render_panels(character, panels, os.path.join(out_dir, f"rigging_{name}.png"), out_dir)
 
 
 def render_bandwidths(path: str, out_dir: str) -> None:
