@@ -408,3 +408,17 @@ def test_the_summary_names_the_known_body_whose_kind_a_body_read_as_other_took(c
     code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--skin", "geometric", "--quiet"], capsys)
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["kind_from"]) == ("free-form", None)
+
+
+def test_rigify_on_a_body_with_a_known_rig_builds_it_on_the_standard_biped(clean_scene, tmp_path, capsys, monkeypatch):
+    source, out = tmp_path / "hero.glb", tmp_path / "hero.blend"
+    save_biped(source)
+    known_twin(monkeypatch)
+
+    code, stdout, _ = run_main(["rig", str(source), "--out", str(out), "--rigify", "--quiet"], capsys)
+
+    assert code == 0
+    (item,) = json.loads(stdout)["succeeded"]
+    # Rigify's metarig is the standard biped's layout: the twin's key joints, not its rig.
+    assert (item["template"], item["rigify"], item["rig_from"], item["key_joints_from"]) == (
+        "biped", True, None, "procedural/biped_twin")
