@@ -13,7 +13,6 @@ bandwidth takes a fraction of a second.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 #: Votes with less attention than this are left out (they would move the
@@ -32,12 +31,16 @@ SEED_MERGE_SHARE = 0.05
 
 
 def _kernel_step(seeds: np.ndarray, tree: cKDTree, points: np.ndarray, weights: np.ndarray, bandwidth: float):
-    """Weighted kernel means at ``seeds`` and the kernel density there."""
+    """Weighted kernel means at ``seeds`` and the kernel density there.
+
+    The kernel's pairs are summed per seed with ``bincount``: a sparse
+    matrix would sort them first, which took 60 % of the clustering."""
     near = cKDTree(seeds).sparse_distance_matrix(tree, KERNEL_REACH * bandwidth, output_type="ndarray")
     values = np.exp(-0.5 * (near["v"] / bandwidth) ** 2) * weights[near["j"]]
-    kernel = sp.csr_matrix((values, (near["i"], near["j"])), shape=(len(seeds), len(points)))
-    density = np.asarray(kernel.sum(axis=1)).reshape(-1)
-    means = np.divide(kernel @ points, density[:, None], out=seeds.copy(), where=density[:, None] > 0)
+    density = np.bincount(near["i"], values, minlength=len(seeds))
+    sums = np.stack([np.bincount(near["i"], values * points[near["j"], axis], minlength=len(seeds))
+                     for axis in range(3)], axis=1)
+    means = np.divide(sums, density[:, None], out=seeds.copy(), where=density[:, None] > 0)
     return means, density
 
 
