@@ -425,6 +425,57 @@ def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(cl
     assert_wholly_on(offhand, armature, "hand.L")
 
 
+def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeypatch):
+    """Telling the swords held reads the body without them; that is the body
+    rigged, so Auto-Rig uses that reading instead of a second prediction pass
+    (the skeleton the same as read afresh)."""
+    from autorig_addon.blender.jobs import rig as rig_job
+    from autorig_addon.core.rigging import held_at_hands
+
+    readings = []
+    for module in (rig_job, held_at_hands):
+        counted = module.predict_votes
+        monkeypatch.setattr(module, "predict_votes", lambda mesh, *args, counted=counted: (
+            readings.append(mesh.vertex_count), counted(mesh, *args))[1])
+    names_alone, _ = bones_of_the_biped_alone()
+    readings.clear()
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    select_only([body, sword, offhand], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert [bone.name for bone in armature.data.bones] == names_alone
+    assert readings == [len(body.data.vertices)]  # one reading, of the body alone
+
+
+def test_a_body_rigged_with_thin_parts_told_its_own_is_read_again(clean_scene, monkeypatch):
+    """Ears that stay the body's (test below) were left out of the body read
+    to tell them: the body rigged differs from it, so it is read afresh."""
+    from autorig_addon.blender.jobs import rig as rig_job
+    from autorig_addon.core.rigging import held_at_hands
+
+    readings = []
+    for module in (rig_job, held_at_hands):
+        counted = module.predict_votes
+        monkeypatch.setattr(module, "predict_votes", lambda mesh, *args, counted=counted: (
+            readings.append(mesh.vertex_count), counted(mesh, *args))[1])
+    body = add_biped()
+    ears = []
+    for name, side in (("Ear.L", 1.0), ("Ear.R", -1.0)):
+        ear = box_mesh((0.03, -0.01, 0.98), (0.07, 0.01, 1.15), 0.02)
+        triangles = ear.triangles if side > 0 else ear.triangles[:, ::-1]
+        ears.append(mesh_object(name, ear.vertices * [side, 1.0, 1.0], triangles))
+    bpy.context.view_layer.update()
+    select_only([body, *ears], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    ear_vertices = sum(len(ear.data.vertices) for ear in ears)
+    assert readings == [len(body.data.vertices), len(body.data.vertices) + ear_vertices]
+
+
 def test_thin_twins_touching_the_head_are_skinned_with_the_body(clean_scene, capfd):
     """Two flat ears standing on the head (a rabbit's, 17 cm tall, 2 cm
     thick), mirror images, thin and sticking out as the swords are: they

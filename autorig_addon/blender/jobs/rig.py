@@ -39,7 +39,7 @@ from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
-from ...core.rigging.held_at_hands import props_held_at_hands
+from ...core.rigging.held_at_hands import BodyReading, held_at_hands_reading
 from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
@@ -160,6 +160,8 @@ class RigPlan:
     held_pieces : tuple of ((k,) int array, (3,) float array): held rigid props joined into one of
         ``meshes`` (a sword joined into the body), their rows in ``mesh`` and their grip; left out of
         the prediction, and Auto-Rig weights each wholly to the deform bone nearest to its grip
+    body_reading : BodyReading or None, a body the prediction already read while telling what the character
+        holds (``core.rigging.held_at_hands``); its votes stand for ``character``'s when it is the same shape
     """
 
     meshes: list
@@ -175,6 +177,7 @@ class RigPlan:
     notes: tuple = ()
     held: tuple = ()
     held_pieces: tuple = ()
+    body_reading: BodyReading | None = None
 
     @property
     def character(self) -> Mesh:
@@ -186,6 +189,15 @@ class RigPlan:
         for rows, _ in self.held_pieces:
             left[rows] = True
         return self.mesh.subset(~left)
+
+    def votes_read_already(self) -> JointVotes | None:
+        """The votes of :attr:`body_reading` when its body is :attr:`character`, vertex for vertex; else None."""
+        if self.body_reading is None:
+            return None
+        body, character = self.body_reading.body, self.character
+        same = np.array_equal(body.vertices, character.vertices) and np.array_equal(body.triangles,
+                                                                                     character.triangles)
+        return self.body_reading.votes if same else None
 
 
 @dataclass
@@ -278,8 +290,8 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
     chosen = meshes
-    meshes, mesh, left_out, notes, held, held_pieces = _the_character(chosen, mesh, named=named,
-                                                                      bound=skin is not None, carried=carried)
+    meshes, mesh, left_out, notes, held, held_pieces, reading = _the_character(
+        chosen, mesh, named=named, bound=skin is not None, carried=carried)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
     if skin is not None and not replace:
@@ -292,7 +304,7 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
                 "it to the new skeleton instead, or remove its Armature modifier first."
             )
     plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
-                   left_out, notes, held, held_pieces)
+                   left_out, notes, held, held_pieces, reading)
     _require_not_flat(meshes, plan.character)
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
@@ -321,6 +333,7 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carrie
     held : tuple of (bpy.types.Object, (3,) array), the props held and their grip (see :class:`RigPlan`)
     held_pieces : tuple of ((k,) int array, (3,) array), the props joined into a mesh: their rows in the
         returned mesh and their grip (see :class:`RigPlan`)
+    reading : BodyReading or None, the body read to tell props held at the hands (see :class:`RigPlan`)
     """
     parts = character_parts(mesh)
     if parts.several:
@@ -330,7 +343,9 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carrie
     props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
                   if prop.object_index not in {known.object_index for known in told}) + told
     # Twins or props across the mirror plane: held when they touch the body at its hands.
-    props += props_held_at_hands(mesh, parts.left_out, [prop.object_index for prop in props if prop.piece is None])
+    at_hands, reading = held_at_hands_reading(mesh, parts.left_out,
+                                              [prop.object_index for prop in props if prop.piece is None])
+    props += at_hands
     dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:
@@ -341,7 +356,7 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carrie
     new_row = np.cumsum(kept_rows) - 1
     held_pieces = tuple((new_row[prop.piece], prop.grip) for prop in props if prop.piece is not None)
     return ([obj for index, obj in enumerate(meshes) if index not in dropped], mesh.subset(kept_rows),
-            left_out if left_out.any() else None, notes, held, held_pieces)
+            left_out if left_out.any() else None, notes, held, held_pieces, reading)
 
 
 def _one_at_a_time(mesh: Mesh, parts: CharacterParts, named: bool) -> str:
@@ -435,7 +450,9 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     being closed), the armature is removed and the meshes restored.
     """
     share = PREDICTION_SHARE if plan.skin is not None else 1.0
-    votes = yield lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share))
+    read = plan.votes_read_already()  # telling the props held at the hands read this very body: not twice
+    votes = yield (lambda progress: read) if read is not None else (
+        lambda progress: predict_votes(plan.character, sub_progress(progress, 0.0, share)))
     # Rigify's control rig is built on a standard skeleton, never on a known body's rig.
     checked = checked_skeleton(votes, known_rig=not plan.rigify, **plan.settings.keywords())
     skeleton, problems = checked.skeleton, checked.problems

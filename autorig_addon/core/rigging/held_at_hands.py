@@ -33,6 +33,7 @@ staff held in both hands goes to the hand holding more of it).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -44,7 +45,7 @@ from ..geometry.normals import triangle_double_areas
 from ..types import Mesh
 from .nearest_character import surface_points
 from .networks.landmarks import BODY_KINDS
-from .predict import predict_votes, sure_standard_kind
+from .predict import JointVotes, predict_votes, sure_standard_kind
 from .props import NEAR_SHARE, OUT_SHARE, PROP_AREA_SHARE, SAMPLES_PER_OBJECT, Prop
 
 #: Thin: the smallest of an object's extents along its principal axes is
@@ -177,8 +178,25 @@ def held_at_hands(candidates, wrists: dict, body_size: float) -> tuple[Prop, ...
     return tuple(held)
 
 
+class BodyReading(NamedTuple):
+    """The body :func:`held_at_hands_reading` read (the mesh without what is
+    not the character, the props told and the candidates) and the
+    prediction's votes on it, which a caller rigging that same body can use
+    instead of reading it again."""
+
+    body: Mesh
+    votes: JointVotes
+
+
 def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Prop, ...]:
-    """The thin objects of ``mesh`` held at the hands (both steps of the module docstring).
+    """The thin objects of ``mesh`` held at the hands (:func:`held_at_hands_reading`)."""
+    return held_at_hands_reading(mesh, left_out, told)[0]
+
+
+def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None,
+                          told=()) -> tuple[tuple[Prop, ...], BodyReading | None]:
+    """The thin objects of ``mesh`` held at the hands (both steps of the module
+    docstring), and the body read to tell them.
 
     The landmark network reads the body (``mesh`` without ``left_out``, the
     ``told`` props and the candidates) only when there is a candidate; a
@@ -193,11 +211,12 @@ def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=())
 
     Returns
     -------
-    tuple of Prop, in the objects' order
+    props : tuple of Prop, in the objects' order
+    reading : BodyReading, or None when no body was read
     """
     candidates = thin_candidates(mesh, left_out, told)
     if not candidates:
-        return ()
+        return (), None
     rows = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
     for index in {candidate.object_index for candidate in candidates} | set(int(index) for index in told):
         rows[mesh.object_slice(index)] = False
@@ -205,10 +224,11 @@ def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=())
     try:
         votes = predict_votes(body)
     except InputError:
-        return ()
+        return (), None
+    reading = BodyReading(body, votes)
     if sure_standard_kind(votes.landmarks) != HOLDING_KIND:
-        return ()
+        return (), reading
     points = votes.landmarks.points_for(HOLDING_KIND)
     to_mesh = np.linalg.inv(votes.transform)
     wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
-    return held_at_hands(candidates, wrists, largest_side(body.vertices))
+    return held_at_hands(candidates, wrists, largest_side(body.vertices)), reading
