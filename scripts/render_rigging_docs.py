@@ -35,7 +35,13 @@ from mathutils import Vector
 
 from autorig_addon.blender.characters import load_character
 from autorig_addon.core.geometry.bounding_box import largest_side
-from autorig_addon.core.rigging.predict import DEFAULT_BANDWIDTH, chosen_template, predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.predict import (
+    DEFAULT_BANDWIDTH,
+    checked_skeleton,
+    chosen_template,
+    predict_votes,
+    skeleton_from_votes,
+)
 from autorig_addon.core.rigging.rig_library import KNOWN_RIG
 from autorig_addon.core.rigging.standard_skeleton import FREE_FORM
 from docs_render import (
@@ -145,8 +151,9 @@ def render_panels(character, skeletons, path: str, out_dir: str) -> None:
 def render_comparison(path: str, out_dir: str) -> None:
     character, votes = character_and_votes(path)
     artist = character.skeleton.deform_subset()
-    standard = skeleton_from_votes(votes)
-    kind, note = chosen_template(votes)
+    checked = checked_skeleton(votes)  # as Auto-Rig builds it
+    standard = checked.skeleton
+    kind, note = chosen_template(votes, known_rig=checked.known_rig)
     free_form = skeleton_from_votes(votes, bandwidth=DEFAULT_BANDWIDTH, template=FREE_FORM)
     name = os.path.splitext(os.path.basename(path))[0]
     print(f"{name}: artist {artist.bone_count} deform bones, default ({kind}) {standard.bone_count} bones, "

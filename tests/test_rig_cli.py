@@ -384,7 +384,7 @@ def test_a_known_rig_that_sits_poorly_on_the_body_gives_way_to_the_standard_skel
     (item,) = json.loads(stdout)["succeeded"]
     assert (item["template"], item["rig_from"], item["problems"]) == ("biped", None, [])
     assert any(note.startswith("The rig of the closest known character, procedural/biped_twin, looks poor on this "
-                               "body (") and note.endswith("): the skeleton was built without it.")
+                               "body (") and note.endswith("): it was not used.")
                for note in item["notes"])
     armature, _ = the_armature_and_mesh(out)
     assert "hair.002" not in armature.data.bones and "neck" in armature.data.bones  # the standard biped's

@@ -328,7 +328,11 @@ def test_a_known_rig_the_checks_find_poor_gives_way_to_the_skeleton_without_it(b
     assert (checked.problems, checked.known_rig) == ((), False)
     assert len(checked.skeleton.names) == 22 and "neck" in checked.skeleton.names  # the standard biped (mitten hands)
     assert checked.notes == (f"The rig of the closest known character, procedural/biped_0, looks poor on this body "
-                             f"({'; '.join(poor)}): the skeleton was built without it.",)
+                             f"({'; '.join(poor)}): it was not used.",)
+    # Built first as a standard biped, as asked, the poor known rig is turned down too: choosing Auto later (the live
+    # panel) cannot bring it back.
+    asked = predict.checked_skeleton(votes, template="biped")
+    assert (asked.known_rig, asked.notes) == (False, ()) and len(asked.skeleton.names) == 22
     # A sound known rig is kept.
     monkeypatch.setattr(rig_library, "shipped_library", lambda: build_rig_library([sample]))
     sound = predict.checked_skeleton(predict.predict_votes(character.mesh))

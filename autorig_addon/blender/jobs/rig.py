@@ -234,8 +234,8 @@ class RigResult:
 class _Prediction:
     """A cached prediction: the network outputs, the skeleton the armature
     had when last built from them (world space, as read back), and whether
-    *Auto* may give a known body's rig there (not after it looked poor on the
-    body; engine names, a setting, turn it off while they are chosen)."""
+    *Auto* may give a known body's rig there (not when the checks found it
+    poor on the body; engine names, a setting, turn it off while chosen)."""
 
     votes: JointVotes
     built: Skeleton
@@ -460,8 +460,9 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     known_rig = checked.known_rig and (plan.settings.names or DEFAULT_PRESET) == DEFAULT_PRESET
     template = plan.settings.template or DEFAULT_TEMPLATE
     if problems and not plan.keep_poor:
-        raise InputError(f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try another "
-                         "Template, or keep it anyway with Keep Poor Result (--keep-poor).")
+        raise InputError(" ".join((*checked.notes,
+                                   f"The predicted skeleton looks poor: {'; '.join(problems)}. Nothing was built: try "
+                                   "another Template, or keep it anyway with Keep Poor Result (--keep-poor).")))
     bound = plan.meshes + [obj for obj, _ in plan.held]
     replaced = _followed_armatures(bound) if plan.skin is not None and plan.replace else []
     armature = build_armature(skeleton, plan.name, context)

@@ -394,8 +394,8 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
 
 class CheckedSkeleton(NamedTuple):
     """A skeleton (:func:`checked_skeleton`), what the checks found wrong in
-    it, whether a known rig was still allowed when it was built, and a note
-    when a poor known rig gave way."""
+    it, whether a known rig may be used for this body, and a note when a
+    poor known rig gave way."""
 
     skeleton: Skeleton
     problems: tuple
@@ -405,20 +405,27 @@ class CheckedSkeleton(NamedTuple):
 
 def checked_skeleton(votes: JointVotes, known_rig: bool = True, **settings) -> CheckedSkeleton:
     """:func:`skeleton_from_votes` with ``settings`` (its keywords) and
-    ``known_rig``, and what :func:`skeleton_quality` finds wrong in it. A
-    known body's rig that the checks find poor on this body (a bone far
-    outside it) gives way to the skeleton the body gets without one, with a
-    note saying why; ``known_rig`` is then False in the result, so that
-    building again (the level-of-detail slider) does not bring it back."""
+    ``known_rig``, and what :func:`skeleton_quality` finds wrong in it.
+
+    A known body's rig (:attr:`JointVotes.known_rig`) is checked first,
+    whether these settings choose it or not: one the checks find poor on this
+    body (a bone far outside it) is not used, and ``known_rig`` is False in
+    the result, so that building again with other settings (the live panel)
+    does not bring it back; when these settings would have chosen it, a note
+    says why it was not used.
+    """
     template, names = settings.get("template", DEFAULT_TEMPLATE), settings.get("names", DEFAULT_PRESET)
+    notes = ()
+    if known_rig and votes.known_rig is not None:
+        fitted = skeleton_from_votes(votes, template=AUTO, known_rig=True)  # the known rig, whatever the settings
+        poor = skeleton_quality(votes, fitted)
+        if poor:
+            if chosen_template(votes, template, names == DEFAULT_PRESET)[0] == KNOWN_RIG:
+                notes = (f"The rig of the closest known character, {votes.known_rig.name}, looks poor on this body "
+                         f"({'; '.join(poor)}): it was not used.",)
+            known_rig = False
     skeleton = skeleton_from_votes(votes, **settings, known_rig=known_rig)
-    problems = skeleton_quality(votes, skeleton)
-    if not problems or chosen_template(votes, template, known_rig and names == DEFAULT_PRESET)[0] != KNOWN_RIG:
-        return CheckedSkeleton(skeleton, problems, known_rig, ())
-    note = (f"The rig of the closest known character, {votes.known_rig.name}, looks poor on this body "
-            f"({'; '.join(problems)}): the skeleton was built without it.")
-    skeleton = skeleton_from_votes(votes, **settings, known_rig=False)
-    return CheckedSkeleton(skeleton, skeleton_quality(votes, skeleton), False, (note,))
+    return CheckedSkeleton(skeleton, skeleton_quality(votes, skeleton), known_rig, notes)
 
 
 def template_notes(votes: JointVotes, template: str = DEFAULT_TEMPLATE, skeleton: Skeleton | None = None,
