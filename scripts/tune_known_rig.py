@@ -22,24 +22,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from autorig_addon.core.dataset.cache import training_samples
 from autorig_addon.core.evaluation.skeleton_metrics import evaluate_rig
 from autorig_addon.core.rigging import predict, rig_library
 from autorig_addon.core.types import Mesh
-from autorig_addon.training.runs import held_out_names
-from tune_rig_library import near_duplicates, without
+from tune_rig_library import held_out_samples, near_duplicates, without
 
 MEASURES = ("cd_j2j", "cd_j2b", "cd_b2b", "iou")
 
 
 def main() -> None:
     library = rig_library.shipped_library()
-    samples = training_samples()
-    held = held_out_names([sample.name for sample in samples])
     rows = []
-    for sample in samples:
-        if sample.name not in held:
-            continue
+    for sample in held_out_samples():
         others = without(library, near_duplicates(sample.name) | {sample.name})
         rig_library.shipped_library = lambda others=others: others
         votes = predict.predict_votes(Mesh(sample.vertices, sample.triangles))

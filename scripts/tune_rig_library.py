@@ -57,6 +57,13 @@ def near_duplicates(name: str) -> set:
     return {name}
 
 
+def held_out_samples() -> list:
+    """The cached training characters the networks never trained on (every sixth by name, ``held_out_names``)."""
+    samples = training_samples()
+    held = held_out_names([sample.name for sample in samples])
+    return [sample for sample in samples if sample.name in held]
+
+
 def without(library: RigLibrary, names: set) -> RigLibrary:
     return library.subset(np.array([name not in names for name in library.names]))
 
@@ -102,12 +109,8 @@ def main() -> None:
         check_screen()
         return
     library = shipped_library()
-    samples = training_samples()
-    held = held_out_names([sample.name for sample in samples])
     rows = []
-    for sample in samples:
-        if sample.name not in held:
-            continue
+    for sample in held_out_samples():
         targets, known, kind_index = sample_landmarks(sample)
         kind = BODY_KINDS[kind_index]
         if kind not in STANDARD_KINDS or not known.any():

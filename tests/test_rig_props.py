@@ -425,10 +425,8 @@ def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(cl
     assert_wholly_on(offhand, armature, "hand.L")
 
 
-def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeypatch):
-    """Telling the swords held reads the body without them; that is the body
-    rigged, so Auto-Rig uses that reading instead of a second prediction pass
-    (the skeleton the same as read afresh)."""
+def counted_readings(monkeypatch) -> list:
+    """The vertex count of every body the prediction reads from now on (Auto-Rig's and held_at_hands' calls)."""
     from autorig_addon.blender.jobs import rig as rig_job
     from autorig_addon.core.rigging import held_at_hands
 
@@ -437,6 +435,14 @@ def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeyp
         counted = module.predict_votes
         monkeypatch.setattr(module, "predict_votes", lambda mesh, *args, counted=counted: (
             readings.append(mesh.vertex_count), counted(mesh, *args))[1])
+    return readings
+
+
+def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeypatch):
+    """Telling the swords held reads the body without them; that is the body
+    rigged, so Auto-Rig uses that reading instead of a second prediction pass
+    (the skeleton the same as read afresh)."""
+    readings = counted_readings(monkeypatch)
     names_alone, _ = bones_of_the_biped_alone()
     readings.clear()
     body = add_biped()
@@ -453,14 +459,7 @@ def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeyp
 def test_a_body_rigged_with_thin_parts_told_its_own_is_read_again(clean_scene, monkeypatch):
     """Ears that stay the body's (test below) were left out of the body read
     to tell them: the body rigged differs from it, so it is read afresh."""
-    from autorig_addon.blender.jobs import rig as rig_job
-    from autorig_addon.core.rigging import held_at_hands
-
-    readings = []
-    for module in (rig_job, held_at_hands):
-        counted = module.predict_votes
-        monkeypatch.setattr(module, "predict_votes", lambda mesh, *args, counted=counted: (
-            readings.append(mesh.vertex_count), counted(mesh, *args))[1])
+    readings = counted_readings(monkeypatch)
     body = add_biped()
     ears = []
     for name, side in (("Ear.L", 1.0), ("Ear.R", -1.0)):
