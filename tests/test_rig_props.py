@@ -13,7 +13,10 @@ import pytest
 
 from autorig_addon.blender import convert, scene_io
 from autorig_addon.blender.armature_builder import build_armature
+from autorig_addon.blender.jobs.rig import HANDS_READING_LABEL, plan_rig_steps, planned_rig_steps
+from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.cli.main import main
+from autorig_addon.core.errors import Cancelled
 from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.procedural import generate_character
@@ -454,6 +457,60 @@ def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeyp
     (armature,) = armatures()
     assert [bone.name for bone in armature.data.bones] == names_alone
     assert readings == [len(body.data.vertices)]  # one reading, of the body alone
+
+
+def test_planning_reads_the_body_for_the_swords_in_a_task_of_its_own(clean_scene, monkeypatch):
+    """Planning only reads Blender's objects; the landmark network reading
+    the body to tell the swords held is a task of the steps, which the
+    operators run in their worker (progress, Esc) like the prediction:
+    before, it ran while the operator started, without either."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    steps = plan_rig_steps([body, sword, offhand], bpy.context.evaluated_depsgraph_get(), "Biped",
+                           skin=SkinSettings())
+
+    task = next(steps)
+    assert readings == []  # nothing read yet: the reading is the task
+    reported = []
+    answer = task(lambda fraction, message: reported.append((fraction, message)))
+    assert readings == [len(body.data.vertices)]
+    assert reported and all(message.startswith(f"{HANDS_READING_LABEL}: ") for _, message in reported)
+    fractions = [fraction for fraction, _ in reported]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    with pytest.raises(StopIteration) as stop:
+        steps.send(answer)
+    plan = stop.value.value
+    assert [obj.name for obj, _ in plan.held] == [sword.name, offhand.name]
+    assert plan.meshes == [body]
+
+
+def test_cancelling_while_the_hands_are_read_builds_nothing(clean_scene):
+    """Esc during that reading (Cancelled thrown in at its task, as the
+    operator's worker does) ends the run with the scene as it was."""
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    before = scene_state([body, sword, offhand])
+    steps = planned_rig_steps(bpy.context, plan_rig_steps([body, sword, offhand],
+                                                          bpy.context.evaluated_depsgraph_get(), "Biped",
+                                                          skin=SkinSettings()))
+    next(steps)
+
+    with pytest.raises(Cancelled):
+        steps.throw(Cancelled())
+    assert armatures() == []
+    assert scene_state([body, sword, offhand]) == before
+
+
+def test_a_body_holding_nothing_thin_is_planned_without_a_task(clean_scene, monkeypatch):
+    """Without a thin object to tell, planning yields no task and reads no body."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+
+    with pytest.raises(StopIteration) as stop:
+        next(plan_rig_steps([body], bpy.context.evaluated_depsgraph_get(), "Biped"))
+    assert stop.value.value.meshes == [body]
+    assert readings == []
 
 
 def biped_with_flat_ears() -> tuple:

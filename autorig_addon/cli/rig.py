@@ -102,7 +102,7 @@ def clear_armatures(replace: bool) -> tuple[list[str], dict]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..blender.jobs.rig import RigSettings, plan_rig, rig_steps, run_steps
+    from ..blender.jobs.rig import RigSettings, plan_rig_steps, planned_rig_steps, run_steps
     from ..blender.jobs.skin import SkinSettings
     from ..core.skinning.options import SkinningOptions
 
@@ -127,14 +127,14 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("The file holds no mesh to rig.")
         # Named meshes are one character of the file: the armature takes the first one's name.
         character = meshes[0].name if named else Path(input_path).stem
-        plan = plan_rig(meshes, bpy.context.evaluated_depsgraph_get(), character, settings,
-                        skin=skin, named=bool(named), rigify=args.rigify, keep_poor=args.keep_poor,
-                        carried=carried)
-        result = run_steps(rig_steps(bpy.context, plan, remember=False), progress)
+        plan_steps = plan_rig_steps(meshes, bpy.context.evaluated_depsgraph_get(), character, settings,
+                                    skin=skin, named=bool(named), rigify=args.rigify, keep_poor=args.keep_poor,
+                                    carried=carried)
+        result = run_steps(planned_rig_steps(bpy.context, plan_steps, remember=False), progress)
         progress(1.0, "Saving")
         scene_io.save_scene(output_path)
         details = {"armature": result.armature.name, "bones": result.skeleton.bone_count,
-                   "meshes": [obj.name for obj in plan.meshes], "skin": args.skin, "template": result.template,
+                   "meshes": [obj.name for obj in result.meshes], "skin": args.skin, "template": result.template,
                    "body": result.body, "confidence": round(result.confidence, 3),
                    "key_joints_from": result.key_joints_from or None, "kind_from": result.kind_from or None,
                    "rig_from": result.rig_from or None,

@@ -25,3 +25,15 @@ def sub_progress(progress: Optional[ProgressCallback], start: float, end: float)
         progress(start + (end - start) * min(max(fraction, 0.0), 1.0), message)
 
     return scaled
+
+
+def labelled_progress(progress: Optional[ProgressCallback], label: str) -> Optional[ProgressCallback]:
+    """A callback that passes on the fraction and puts ``label: `` before each message
+    of ``progress`` (a step that runs the same work as a later one says which it is)."""
+    if progress is None:
+        return None
+
+    def labelled(fraction: float, message: str) -> None:
+        progress(fraction, f"{label}: {message}")
+
+    return labelled

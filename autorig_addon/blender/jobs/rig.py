@@ -37,9 +37,9 @@ from ...core.errors import InputError
 from ...core.geometry.flatness import flatness
 from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
-from ...core.progress import ProgressCallback, sub_progress
+from ...core.progress import ProgressCallback, labelled_progress, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
-from ...core.rigging.held_at_hands import BodyReading, held_at_hands_reading
+from ...core.rigging.held_at_hands import BodyReading, held_at_hands_reading, thin_candidates
 from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
@@ -213,7 +213,8 @@ class RigResult:
     otherwise), ``rig_from`` the known body whose whole rig was fitted
     (``known rig``; empty otherwise), ``rigify`` whether Rigify's control
     rig was generated, ``problems`` what the checks found in a poor skeleton
-    kept on request."""
+    kept on request, ``meshes`` the character's meshes the run took (those
+    wholly left out, such as a ground plane, dropped)."""
 
     armature: object
     skeleton: Skeleton
@@ -228,6 +229,7 @@ class RigResult:
     rig_from: str = ""
     rigify: bool = False
     problems: tuple = ()
+    meshes: tuple = ()
 
 
 @dataclass
@@ -244,11 +246,32 @@ class _Prediction:
 
 _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
 
+#: A step's task, run by a worker (the operators) or on this thread (:func:`run_steps`).
+Task = Callable[[ProgressCallback | None], object]
+#: What the progress says while the body is read to tell what its hands hold.
+HANDS_READING_LABEL = "Telling what the hands hold"
+
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
              skin: SkinSettings | None = None, replace: bool = False, named: bool = True,
              rigify: bool = False, keep_poor: bool = False, carried: dict | None = None) -> RigPlan:
-    """Read and check the character's meshes; raises :class:`InputError` on bad input.
+    """:func:`plan_rig_steps` run on this thread: the plan. Raises :class:`InputError` on bad input."""
+    return run_steps(plan_rig_steps(meshes, depsgraph, name, settings, skin=skin, replace=replace, named=named,
+                                    rigify=rigify, keep_poor=keep_poor, carried=carried))
+
+
+def plan_rig_steps(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
+                   skin: SkinSettings | None = None, replace: bool = False, named: bool = True,
+                   rigify: bool = False, keep_poor: bool = False,
+                   carried: dict | None = None) -> Generator[Task, object, RigPlan]:
+    """Read and check the character's meshes, as steps (see :func:`rig_steps`) that return the
+    plan; raises :class:`InputError` on bad input.
+
+    The steps yield one task at most: the landmark network reading the body
+    to tell thin objects held at the hands (``core.rigging.held_at_hands``),
+    only when the character has such a candidate. The operators run it in
+    the worker like the prediction (progress, Esc), not while the operator
+    starts; the rest reads Blender's objects and is quick.
 
     What is not the character (``core.rigging.character_parts``) is told
     apart here: a ground plane and stray specks are left out (a mesh wholly
@@ -289,8 +312,10 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     mesh = rest.mesh
     require_finite_positions(mesh.vertices, mesh.object_names, mesh.object_offsets)
     _require_rigged_shape_is_seen(meshes, places, rest, depsgraph)
+    if rigify and settings.template == FREE_FORM:
+        raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
     chosen = meshes
-    meshes, mesh, left_out, notes, held, held_pieces, reading = _the_character(
+    meshes, mesh, left_out, notes, held, held_pieces, reading = yield from _the_character(
         chosen, mesh, named=named, bound=skin is not None, carried=carried)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
@@ -306,15 +331,16 @@ def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSett
     plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
                    left_out, notes, held, held_pieces, reading)
     _require_not_flat(meshes, plan.character)
-    if rigify and settings.template == FREE_FORM:
-        raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
     return plan
 
 
-def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carried: dict | None = None) -> tuple:
+def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool,
+                   carried: dict | None = None) -> Generator[Task, object, tuple]:
     """Tell the character from what is not (``core.rigging.character_parts``,
     ``core.rigging.props``): refuse several characters, naming them; leave
-    out a ground plane, stray specks and rigid props.
+    out a ground plane, stray specks and rigid props. Steps: yields the
+    reading of the body that tells the thin objects held at the hands as a
+    task when there is a candidate, and returns the tuple below.
 
     Parameters
     ----------
@@ -342,9 +368,12 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool, carrie
     told = carried_props(mesh, on_bones) if on_bones else ()
     props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
                   if prop.object_index not in {known.object_index for known in told}) + told
-    # Twins or props across the mirror plane: held when they touch the body at its hands.
-    at_hands, reading = held_at_hands_reading(mesh, parts.left_out,
-                                              [prop.object_index for prop in props if prop.piece is None])
+    # Twins or props across the mirror plane: held when they touch the body at its hands, which takes a reading.
+    told_objects = [prop.object_index for prop in props if prop.piece is None]
+    candidates = thin_candidates(mesh, parts.left_out, told_objects)
+    at_hands, reading = (yield lambda progress: held_at_hands_reading(
+        mesh, parts.left_out, told_objects, candidates=candidates,
+        progress=labelled_progress(progress, HANDS_READING_LABEL))) if candidates else ((), None)
     props += at_hands
     dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
@@ -435,8 +464,6 @@ def _remember(armature, votes: JointVotes, known_rig: bool = True) -> None:
         _PREDICTIONS.popitem(last=False)
 
 
-Task = Callable[[ProgressCallback | None], object]
-
 
 def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Task, object, RigResult]:
     """The steps of a prediction (and, with ``plan.skin``, the binding).
@@ -487,7 +514,7 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
                 target, notes = rig, (*notes, *rigify_notes)
         result = RigResult(target, convert.read_skeleton(target) if rig is not None else skeleton, notes,
                            template=chosen_template(votes, template, known_rig)[0], rigify=rig is not None,
-                           problems=problems)
+                           problems=problems, meshes=tuple(plan.meshes))
         if votes.landmarks is not None:
             result.body, result.confidence = votes.landmarks.kind, votes.landmarks.confidence
             copied = votes.landmarks.copied_for(result.template)
@@ -524,6 +551,15 @@ def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Tas
     # Last, once nothing can fail: a removed armature cannot be restored.
     result.notes = (*result.notes, *_remove_unused(replaced))
     return result
+
+
+def planned_rig_steps(context, plan_steps: Generator[Task, object, RigPlan], *,
+                      remember: bool = True) -> Generator[Task, object, RigResult]:
+    """``plan_steps`` (:func:`plan_rig_steps`) then :func:`rig_steps` on the plan they
+    return, as one run of steps: an operator started on them runs every slow
+    part in its worker, the reading that tells what the hands hold too."""
+    plan = yield from plan_steps
+    return (yield from rig_steps(context, plan, remember=remember))
 
 
 def _followed_armatures(meshes) -> list:

@@ -11,7 +11,7 @@ import bpy
 from ...core.errors import Cancelled, InputError
 from ...core.rigging.options import KEEP_POOR, REPLACE_BINDING, RIGIFY
 from ..jobs.input_checks import mode_poll
-from ..jobs.rig import RigPlan, RigResult, TaskJob, plan_rig, rig_steps, run_steps
+from ..jobs.rig import RigResult, TaskJob, plan_rig_steps, planned_rig_steps, run_steps
 from ..jobs.skin import SkinSettings
 from ..progress import blender_progress
 from ..selection import character_name, selected_meshes
@@ -53,24 +53,23 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
     def skin_settings(self) -> SkinSettings | None:
         return None
 
-    def make_plan(self, context) -> RigPlan:
+    def run_steps_of(self, context):
+        """The steps of the whole run: planning (its one slow part, telling what the hands hold, a task of
+        its own) then the prediction and binding."""
         meshes = selected_meshes(context)
         name = character_name(meshes, context.active_object) if meshes else ""
-        return plan_rig(meshes, context.evaluated_depsgraph_get(), name, rig_settings_from(self),
-                        skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)),
-                        rigify=bool(getattr(self, "rig_rigify", False)), keep_poor=self.rig_keep_poor)
+        plan_steps = plan_rig_steps(meshes, context.evaluated_depsgraph_get(), name, rig_settings_from(self),
+                                    skin=self.skin_settings(), replace=bool(getattr(self, "rig_replace", False)),
+                                    rigify=bool(getattr(self, "rig_rigify", False)), keep_poor=self.rig_keep_poor)
+        return planned_rig_steps(context, plan_steps)
 
     def invoke(self, context, event):
         for name, value in scene_values(context, self.option_names(), self.properties.is_property_set).items():
             setattr(self, name, value)
         if bpy.app.background or context.window_manager is None or not context.window_manager.windows:
             return self.execute(context)
-        try:
-            plan = self.make_plan(context)
-        except InputError as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self._steps = rig_steps(context, plan)
+        # Refusals of bad input come from the first advance, before anything is built.
+        self._steps = self.run_steps_of(context)
         outcome = self._advance(context, None, None)
         if outcome is not None:
             return outcome
@@ -132,9 +131,8 @@ class _RigOperator(ModalJobOperator, RigOptionProperties):
 
     def execute(self, context):
         try:
-            plan = self.make_plan(context)
             with blender_progress(context, RIG_PROGRESS_TITLE) as progress:
-                result = run_steps(rig_steps(context, plan), progress)
+                result = run_steps(self.run_steps_of(context), progress)
         except (InputError, Cancelled) as error:
             return self._fail(error)
         return self._finish(context, result)

@@ -42,6 +42,7 @@ from ..errors import InputError
 from ..geometry.bounding_box import largest_side
 from ..geometry.closest_point import TriangleMeshQuery
 from ..geometry.normals import triangle_double_areas
+from ..progress import ProgressCallback
 from ..types import Mesh
 from .nearest_character import surface_points
 from .networks.landmarks import BODY_KINDS
@@ -193,8 +194,9 @@ def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=())
     return held_at_hands_reading(mesh, left_out, told)[0]
 
 
-def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None,
-                          told=()) -> tuple[tuple[Prop, ...], BodyReading | None]:
+def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(), *,
+                          candidates: tuple[Candidate, ...] | None = None,
+                          progress: ProgressCallback | None = None) -> tuple[tuple[Prop, ...], BodyReading | None]:
     """The thin objects of ``mesh`` held at the hands (both steps of the module
     docstring), and the body read to tell them.
 
@@ -208,13 +210,17 @@ def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None,
     mesh : Mesh, world space, one or more objects
     left_out : (n,) bool array or None, vertices that are not the character
     told : indices of objects already told as props
+    candidates : tuple of Candidate or None, :func:`thin_candidates` of the same arguments when the
+        caller found them already (a job deciding whether the reading is worth a task of its own)
+    progress : optional ProgressCallback of the reading (may raise Cancelled)
 
     Returns
     -------
     props : tuple of Prop, in the objects' order
     reading : BodyReading, or None when no body was read
     """
-    candidates = thin_candidates(mesh, left_out, told)
+    if candidates is None:
+        candidates = thin_candidates(mesh, left_out, told)
     if not candidates:
         return (), None
     rows = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
@@ -222,7 +228,7 @@ def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None,
         rows[mesh.object_slice(index)] = False
     body = mesh.subset(rows)
     try:
-        votes = predict_votes(body)
+        votes = predict_votes(body, progress)
     except InputError:
         return (), None
     reading = BodyReading(body, votes)
