@@ -7,7 +7,7 @@ Usage (from the repo root, with bpy in the venv)::
 
 For every .glb of several meshes with faces, read at rest in world space:
 the objects :mod:`~autorig_addon.core.rigging.props` tells as props, the
-thin candidates, and those held at the hands. One line per file; files of
+thin and the thick candidates, and those held at the hands. One line per file; files of
 several characters are left out, as ``rig`` refuses them.
 """
 
@@ -20,7 +20,7 @@ import bpy
 
 from autorig_addon.blender import convert, scene_io
 from autorig_addon.core.rigging.character_parts import character_parts
-from autorig_addon.core.rigging.held_at_hands import props_held_at_hands, thin_candidates
+from autorig_addon.core.rigging.held_at_hands import hand_candidates, props_held_at_hands
 from autorig_addon.core.rigging.props import rigid_props
 
 DEFAULT_CHARACTERS = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "characters"
@@ -38,11 +38,12 @@ def main(folder: Path) -> None:
         if parts.several:
             continue
         told = [prop.object_index for prop in rigid_props(mesh, parts.left_out) if prop.piece is None]
-        candidates = thin_candidates(mesh, parts.left_out, told)
+        candidates = hand_candidates(mesh, parts.left_out, told)
         held = props_held_at_hands(mesh, parts.left_out, told) if candidates else ()
         names = mesh.object_names
         print(f"{path.relative_to(folder)}: {len(objects)} objects, props {[names[index] for index in told]}, "
-              f"thin {[names[candidate.object_index] for candidate in candidates]}, "
+              f"thin {[names[candidate.object_index] for candidate in candidates if candidate.thin]}, "
+              f"thick {[names[candidate.object_index] for candidate in candidates if not candidate.thin]}, "
               f"held {[names[prop.object_index] for prop in held]}", flush=True)
 
 

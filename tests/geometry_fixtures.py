@@ -246,3 +246,12 @@ def card_strip(top, bottom, width: float, segments: int = 2, two_sided: bool = F
     if two_sided:
         triangles = np.concatenate([triangles, triangles[:, ::-1]])
     return Mesh(vertices, triangles)
+
+
+def procedural_biped_with(*objects) -> Mesh:
+    """The procedural biped of seed 0 (right hand near x -0.28, z 0.57), object ``Biped``, with
+    ``objects`` ((name, Mesh) pairs) after it as objects of their own."""
+    character = generate_character(0, "biped")
+    body = Mesh(character.mesh.vertices, character.mesh.triangles, object_names=("Biped",))
+    return Mesh.concatenate([body, *(Mesh(mesh.vertices, mesh.triangles, object_names=(name,))
+                                     for name, mesh in objects)])

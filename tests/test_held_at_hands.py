@@ -1,5 +1,5 @@
-"""Thin props held at the hands (autorig_addon.core.rigging.held_at_hands):
-how thin a shape is, which objects may be held, and which are."""
+"""Props held at the hands (autorig_addon.core.rigging.held_at_hands):
+how thin a shape is, which objects may be held, thin or thick, and which are."""
 
 import numpy as np
 import pytest
@@ -7,17 +7,26 @@ import pytest
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging.held_at_hands import (
     AT_HAND_SHARE,
+    HAND_PAST,
     HAND_REACH,
     THIN_RATIO,
     Candidate,
+    hand_candidates,
     held_at_hands,
+    own_hands,
     props_held_at_hands,
+    thick_candidates,
     thin_candidates,
     thinness,
 )
 from autorig_addon.core.rigging.nearest_character import surface_points
 from autorig_addon.core.types import Mesh
-from geometry_fixtures import box_mesh
+from geometry_fixtures import box_mesh, procedural_biped_with
+
+
+def mirror_image(mesh: Mesh) -> Mesh:
+    """``mesh`` mirrored across x = 0, its faces turned so they still face out."""
+    return Mesh(mesh.vertices * [-1.0, 1.0, 1.0], mesh.triangles[:, ::-1])
 
 
 def box_points(low, high) -> np.ndarray:
@@ -95,20 +104,85 @@ def test_the_procedural_bipeds_mirrored_swords_are_held_and_its_ears_are_not():
     sword through each hand, mirror images, and two flat ears on its head:
     all four are thin candidates; the swords touch it at the wrists the
     landmark network reads, the ears at the head."""
-    character = generate_character(0, "biped")
-    body = Mesh(character.mesh.vertices, character.mesh.triangles, object_names=("Biped",))
     sword = box_mesh((-0.286, -0.5, 0.565), (-0.27, 0.03, 0.581), 0.02)
     ear = box_mesh((0.03, -0.01, 0.98), (0.07, 0.01, 1.15), 0.02)
-    parts = [body]
-    for name, box in (("Sword", sword), ("Sword.L", sword), ("Ear.L", ear), ("Ear.R", ear)):
-        mirrored = name in ("Sword.L", "Ear.R")
-        vertices = box.vertices * [-1.0, 1.0, 1.0] if mirrored else box.vertices
-        triangles = box.triangles[:, ::-1] if mirrored else box.triangles
-        parts.append(Mesh(vertices, triangles, object_names=(name,)))
-    mesh = Mesh.concatenate(parts)
+    mesh = procedural_biped_with(("Sword", sword), ("Sword.L", mirror_image(sword)), ("Ear.L", ear),
+                                 ("Ear.R", mirror_image(ear)))
     assert [candidate.object_index for candidate in thin_candidates(mesh)] == [1, 2, 3, 4]
     props = props_held_at_hands(mesh)
     assert [prop.object_index for prop in props] == [1, 2]
     # Gripped where the blades pass through the hands.
     np.testing.assert_allclose(props[0].grip, [-0.278, -0.01, 0.573], atol=0.03)
     np.testing.assert_allclose(props[1].grip, [0.278, -0.01, 0.573], atol=0.03)
+
+
+def test_a_body_goes_on_past_a_wrist_only_where_it_has_a_hand_of_its_own():
+    """own_hands: vertices within a hand's reach of the wrist and HAND_PAST beyond it along the forearm."""
+    size = 2.0
+    wrists = {"wrist.L": np.array([0.5, 0.0, 1.0]), "wrist.R": np.array([-0.5, 0.0, 1.0])}
+    elbows = {"elbow.L": np.array([0.3, 0.0, 1.0]), "elbow.R": np.array([-0.3, 0.0, 1.0])}
+    forearms = np.array([[x, 0.0, 1.0] for x in np.linspace(-0.5, 0.5, 41)])
+    past = 1.2 * HAND_PAST * size
+    left_hand = np.array([[0.5 + past, 0.0, 1.0]])
+    hands = own_hands(wrists, elbows, np.vstack([forearms, left_hand]), size)
+    assert list(hands) == ["wrist.L"]
+    np.testing.assert_allclose(hands["wrist.L"], [1.0, 0.0, 0.0])
+    # Short of HAND_PAST, or with no elbow to tell the forearm's direction: no hand.
+    short = np.array([[0.5 + 0.8 * HAND_PAST * size, 0.0, 1.0]])
+    assert own_hands(wrists, elbows, np.vstack([forearms, short]), size) == {}
+    assert own_hands(wrists, {}, np.vstack([forearms, left_hand]), size) == {}
+
+
+def test_a_thick_candidate_is_held_only_in_a_hand_of_the_bodys_own_and_past_the_wrist():
+    size = 2.0
+    wrists = {"wrist.L": np.array([0.5, 0.0, 1.0]), "wrist.R": np.array([-0.5, 0.0, 1.0])}
+    reach = HAND_REACH * size
+    rng = np.random.default_rng(1)
+    at_right = wrists["wrist.R"] + rng.uniform(-0.3, 0.3, (30, 3)) * reach
+    # A mug in the right hand: its surface past the wrist (toward -x, the right forearm's way) ...
+    mug_surface = wrists["wrist.R"] + [-0.08, -0.05, 0.0] + rng.uniform(-0.04, 0.04, (200, 3))
+    mug = Candidate(1, mug_surface, at_right, 0.0, thin=False)
+    # ... and a cuff around the forearm short of the wrist, touching at the same place.
+    cuff = Candidate(2, wrists["wrist.R"] + [0.08, 0.0, 0.0] + rng.uniform(-0.04, 0.04, (200, 3)), at_right,
+                     0.0, thin=False)
+    right_hand = {"wrist.R": np.array([-1.0, 0.0, 0.0])}
+    props = held_at_hands([mug, cuff], wrists, size, {1: right_hand, 2: right_hand})
+    assert [prop.object_index for prop in props] == [1]
+    np.testing.assert_allclose(props[0].grip, at_right.mean(axis=0))
+    # Without a hand of the body's own there (the object may be the hand), or not told: not held.
+    assert held_at_hands([mug], wrists, size, {1: {"wrist.L": np.array([1.0, 0.0, 0.0])}}) == ()
+    assert held_at_hands([mug], wrists, size) == ()
+
+
+def test_the_procedural_bipeds_mirrored_mugs_are_thick_candidates_held_in_its_hands():
+    """A mug (a box 6 cm across) in front of each hand, mirror images: not thin, held all the same."""
+    mug = box_mesh((-0.33, -0.06, 0.50), (-0.27, 0.0, 0.58), 0.01)
+    mesh = procedural_biped_with(("Mug", mug), ("Mug.L", mirror_image(mug)))
+    assert thin_candidates(mesh) == ()
+    assert [(candidate.object_index, candidate.thin) for candidate in hand_candidates(mesh)] == [(1, False),
+                                                                                               (2, False)]
+    props = props_held_at_hands(mesh)
+    assert [prop.object_index for prop in props] == [1, 2]
+    np.testing.assert_allclose(props[0].grip, [-0.289, -0.011, 0.558], atol=0.02)
+    np.testing.assert_allclose(props[1].grip, [0.289, -0.011, 0.558], atol=0.02)
+
+
+def test_hands_that_are_objects_of_their_own_are_not_held():
+    """The biped's hands and the ends of its forearms cut off into objects of their own (x beyond 0.21;
+    the wrists lie near 0.26): thick candidates at the wrists, but without them the body ends short of
+    the wrists, so they are the hands, not what the hands hold."""
+    character = generate_character(0, "biped").mesh
+    vertices, triangles = character.vertices, character.triangles
+    cut = (np.abs(vertices[triangles][:, :, 0]) > 0.21).all(axis=1)
+    side = np.sign(vertices[triangles[:, 0], 0])
+
+    def piece(mask, name):
+        used = np.unique(triangles[mask])
+        index = np.full(len(vertices), -1)
+        index[used] = np.arange(len(used))
+        return Mesh(vertices[used], index[triangles[mask]], object_names=(name,))
+
+    mesh = Mesh.concatenate([piece(~cut, "Body"), piece(cut & (side < 0), "Hand.R"),
+                             piece(cut & (side > 0), "Hand.L")])
+    assert [candidate.object_index for candidate in thick_candidates(mesh)] == [1, 2]
+    assert props_held_at_hands(mesh) == ()

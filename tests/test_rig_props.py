@@ -20,6 +20,7 @@ from autorig_addon.core.errors import Cancelled
 from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.geometry.segments import point_segment_distances
 from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.rigging.held_at_hands import hand_candidates
 from blender_fixtures import (
     BIPED_SEED,
     add_biped,
@@ -34,7 +35,7 @@ from blender_fixtures import (
     scene_state,
     select_only,
 )
-from geometry_fixtures import box_mesh
+from geometry_fixtures import box_mesh, procedural_biped_with
 
 pytestmark = pytest.mark.all_blenders
 
@@ -428,6 +429,37 @@ def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(cl
     assert_wholly_on(offhand, armature, "hand.L")
 
 
+#: A mug (a box 6 cm across and 8 cm tall) held in front of the right hand, its mirror image in the left.
+MUG_LOW, MUG_HIGH = (-0.33, -0.06, 0.50), (-0.27, 0.0, 0.58)
+
+
+def test_auto_rig_binds_a_mug_in_each_hand_wholly_to_its_hand(clean_scene, capfd):
+    """A mug in each hand, mirror images: not thin, so before they stayed
+    part of the body (a twin each) and were skinned over the hand and the
+    forearm. Small, sticking out and touching the body in a hand of its own
+    (core.rigging.held_at_hands.thick_candidates), each is now a held prop:
+    no bones of its own, bound wholly to its hand, posing the hand moves it
+    without bending it."""
+    names_alone, _ = bones_of_the_biped_alone()
+    body = add_biped()
+    low, high = np.array(MUG_LOW), np.array(MUG_HIGH)
+    right = box_mesh(low, high, 0.01)
+    mugs = [mesh_object("Mug", right.vertices, right.triangles),
+            mesh_object("Mug.L", right.vertices * [-1.0, 1.0, 1.0], right.triangles[:, ::-1])]
+    bpy.context.view_layer.update()
+    select_only([body, *mugs], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    (armature,) = armatures()
+    assert [bone.name for bone in armature.data.bones] == names_alone
+    out = capfd.readouterr().out
+    for mug, bone in zip(mugs, ("hand.R", "hand.L")):
+        assert f"'{mug.name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
+        assert_wholly_on(mug, armature, bone)
+    assert_bound_wholly_to(mugs[0], armature, "hand.R")
+
+
 def counted_readings(monkeypatch) -> list:
     """The vertex count of every body the prediction reads from now on (Auto-Rig's and held_at_hands' calls)."""
     from autorig_addon.blender.jobs import rig as rig_job
@@ -511,6 +543,27 @@ def test_a_body_holding_nothing_thin_is_planned_without_a_task(clean_scene, monk
         next(plan_rig_steps([body], bpy.context.evaluated_depsgraph_get(), "Biped"))
     assert stop.value.value.meshes == [body]
     assert readings == []
+
+
+def test_a_body_with_a_small_thick_part_of_its_own_is_read_once(clean_scene, monkeypatch):
+    """A top hat (a box 10 cm across, 17 cm tall) on the head is a thick candidate
+    (core.rigging.held_at_hands.thick_candidates): it stays in the body read to tell what the hands hold,
+    is not held, and that reading is the body rigged: one reading, the hat skinned to the head."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+    box = box_mesh((-0.05, -0.05, 0.95), (0.05, 0.05, 1.12), 0.01)
+    assert [(candidate.object_index, candidate.thin) for candidate in
+            hand_candidates(procedural_biped_with(("Hat", box)))] == [(1, False)]
+    hat = mesh_object("Hat", box.vertices, box.triangles)
+    bpy.context.view_layer.update()
+    select_only([body, hat], active=body)
+
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+
+    assert readings == [len(body.data.vertices) + len(hat.data.vertices)]
+    (armature,) = armatures()
+    skeleton = convert.read_skeleton(armature)
+    assert group_weights(hat, skeleton.names)[:, skeleton.names.index("head")].mean() > 0.9
 
 
 def biped_with_flat_ears() -> tuple:

@@ -39,7 +39,7 @@ from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, labelled_progress, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
-from ...core.rigging.held_at_hands import BodyReading, held_at_hands_reading, thin_candidates
+from ...core.rigging.held_at_hands import BodyReading, hand_candidates, held_at_hands_reading
 from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
@@ -370,7 +370,7 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool,
                   if prop.object_index not in {known.object_index for known in told}) + told
     # Twins or props across the mirror plane: held when they touch the body at its hands, which takes a reading.
     told_objects = [prop.object_index for prop in props if prop.piece is None]
-    candidates = thin_candidates(mesh, parts.left_out, told_objects)
+    candidates = hand_candidates(mesh, parts.left_out, told_objects)
     at_hands, reading = (yield lambda progress: held_at_hands_reading(
         mesh, parts.left_out, told_objects, candidates=candidates,
         progress=labelled_progress(progress, HANDS_READING_LABEL))) if candidates else ((), None)

@@ -1,4 +1,4 @@
-"""Thin props held at the hands, twin or not: a sword in each hand, a staff held in both.
+"""Props held at the hands, twin or not: a sword in each hand, a staff held in both, a mug in each hand.
 
 :mod:`.props` tells a prop by its lacking a twin across the body's mirror
 plane, so a mirrored pair (a sword in each hand) or a prop lying across the
@@ -24,6 +24,15 @@ where they touch the body does. Here:
    a cape the neck; a hand, a glove or a gauntlet of its own (or both hands
    in one object, which is thin across the two) lies within a hand's reach
    of its wrist.
+
+A small object that is not thin (a mug, a lantern, a ball: **thick**,
+:func:`thick_candidates`) may be a body part of its own as well (KayKit's
+arms, legs and heads, a hand, a foot), so it stays in the body the network
+reads, and it is held only in a hand of the body's own: the body without it
+goes on at least :data:`HAND_PAST` of its largest side past the wrist along
+the forearm (:func:`own_hands`; a hand of its own leaves the body ending at
+the wrist), and the object's surface lies past the wrist on the whole (in
+the hand, not a cuff around the forearm).
 
 The caller binds what is held wholly to the bone nearest its grip, the
 mean of where it touches the body near the wrist that holds most of it (a
@@ -62,15 +71,19 @@ AT_HAND_SHARE = 0.5
 #: from that wrist: a blade, a staff or a shield reaches out of the hand; a
 #: hand, a glove or a short claw does not (they stay the body's).
 BEYOND_HAND_SHARE = 0.5
-#: The wrists the landmark network reads, left and right (core.skeleton.key_joints).
+#: The wrists and elbows the landmark network reads, left and right (core.skeleton.key_joints).
 WRISTS = ("wrist.L", "wrist.R")
+ELBOWS = ("elbow.L", "elbow.R")
+#: A hand of the body's own goes on at least this share of the body's largest side past its wrist (a
+#: human hand: about 0.05 of the height); a thick candidate is held only in such a hand.
+HAND_PAST = 0.03
 #: Only a body read as a biped (surely, or by its nearest known body) has hands to hold with.
 HOLDING_KIND = BODY_KINDS[0]
 
 
 @dataclass(frozen=True, eq=False)
 class Candidate:
-    """A thin object of the character that may be held (:func:`thin_candidates`).
+    """An object of the character that may be held (:func:`thin_candidates`, :func:`thick_candidates`).
 
     Attributes
     ----------
@@ -79,12 +92,14 @@ class Candidate:
     touching : (k, 3) float array, world space: those within :data:`.props.NEAR_SHARE`
         of the body's largest side of the body's surface, k >= 1
     gap : float, the smallest distance from those points to the body's surface, scene units
+    thin : bool, thin (a blade, a staff, a shield), or not (a mug: held only in a hand of the body's own)
     """
 
     object_index: int
     surface: np.ndarray
     touching: np.ndarray
     gap: float
+    thin: bool = True
 
 
 def thinness(points: np.ndarray) -> float:
@@ -96,8 +111,42 @@ def thinness(points: np.ndarray) -> float:
     return float(extents.min() / extents.max()) if extents.max() > 0 else 1.0
 
 
+def _small_objects(mesh: Mesh, left_out: np.ndarray | None, told) -> tuple:
+    """The objects of ``mesh`` small enough to be props (under :data:`.props.PROP_AREA_SHARE` of the
+    rest's area), whole (none of their vertices ``left_out``) and not ``told``: ``(triangles, owner,
+    points)``, the faces with area that are not left out, the object of each, and a dict mapping each
+    small object's index to points drawn on its surface."""
+    objects = len(mesh.object_names)
+    vertices = mesh.vertices
+    kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
+    triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)]
+    double_areas = triangle_double_areas(vertices, triangles)
+    triangles, double_areas = triangles[double_areas > 0], double_areas[double_areas > 0]
+    owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
+    area = 0.5 * np.bincount(owner, weights=double_areas, minlength=objects)
+    points = {}
+    for index in range(objects):
+        whole = kept[mesh.object_slice(index)].all()
+        if index in told or not whole or area[index] <= 0:
+            continue
+        if area[index] >= PROP_AREA_SHARE * (area.sum() - area[index] - sum(area[j] for j in told)):
+            continue
+        points[index] = surface_points(vertices, triangles[owner == index], SAMPLES_PER_OBJECT)
+    return triangles, owner, points
+
+
+def _touching(points: np.ndarray, query: TriangleMeshQuery, near: float) -> tuple[np.ndarray, float] | None:
+    """Where ``points`` come within ``near`` of the body (``query``) and their smallest distance to it,
+    when they touch it and mostly stick out of it (over :data:`.props.OUT_SHARE` farther); else None."""
+    distances = query.closest(points).distances
+    touching = distances <= near
+    if touching.any() and np.mean(~touching) > OUT_SHARE:
+        return points[touching], float(distances.min())
+    return None
+
+
 def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
-    """The objects of ``mesh`` that may be props held at the hands (module docstring, step 1).
+    """The thin objects of ``mesh`` that may be props held at the hands (module docstring, step 1).
 
     Parameters
     ----------
@@ -110,49 +159,100 @@ def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> 
     -------
     tuple of Candidate in the objects' order; empty for a mesh of one object
     """
-    objects = len(mesh.object_names)
-    if objects < 2:
+    if len(mesh.object_names) < 2:
         return ()
-    vertices = mesh.vertices
-    kept = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
-    triangles = mesh.triangles[kept[mesh.triangles].all(axis=1)]
-    double_areas = triangle_double_areas(vertices, triangles)
-    triangles, double_areas = triangles[double_areas > 0], double_areas[double_areas > 0]
-    owner = np.searchsorted(mesh.object_offsets, triangles[:, 0], side="right") - 1
-    area = 0.5 * np.bincount(owner, weights=double_areas, minlength=objects)
     told = set(int(index) for index in told)
-    thin = {}
-    for index in range(objects):
-        whole = kept[mesh.object_slice(index)].all()
-        if index in told or not whole or area[index] <= 0:
-            continue
-        if area[index] >= PROP_AREA_SHARE * (area.sum() - area[index] - sum(area[j] for j in told)):
-            continue
-        points = surface_points(vertices, triangles[owner == index], SAMPLES_PER_OBJECT)
-        if thinness(points) < THIN_RATIO:
-            thin[index] = points
+    triangles, owner, small = _small_objects(mesh, left_out, told)
+    thin = {index: points for index, points in small.items() if thinness(points) < THIN_RATIO}
     body = triangles[~np.isin(owner, list(told | set(thin)))]
     if not thin or not len(body):
         return ()
-    near = NEAR_SHARE * largest_side(vertices[np.unique(body)])
-    query = TriangleMeshQuery(vertices, body)
+    near = NEAR_SHARE * largest_side(mesh.vertices[np.unique(body)])
+    query = TriangleMeshQuery(mesh.vertices, body)
     candidates = []
     for index, points in sorted(thin.items()):
-        distances = query.closest(points).distances
-        touching = distances <= near
-        if touching.any() and np.mean(~touching) > OUT_SHARE:
-            candidates.append(Candidate(index, points, points[touching], float(distances.min())))
+        touching = _touching(points, query, near)
+        if touching is not None:
+            candidates.append(Candidate(index, points, *touching))
     return tuple(candidates)
 
 
-def held_at_hands(candidates, wrists: dict, body_size: float) -> tuple[Prop, ...]:
+def thick_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=(), thin=()) -> tuple[Candidate, ...]:
+    """The small objects of ``mesh`` that are not thin and may be held at the hands all the same (a mug,
+    a lantern, a ball; module docstring): small, sticking out of the rest and touching it. Unlike thin
+    ones they stay in the body the landmark network reads (KayKit's arms, legs and heads are such objects
+    of their own); each is measured against the body without it.
+
+    Parameters
+    ----------
+    mesh, left_out, told : as for :func:`thin_candidates`
+    thin : indices of the thin candidates (:func:`thin_candidates`), not the body
+
+    Returns
+    -------
+    tuple of Candidate (``thin`` False) in the objects' order; empty for a mesh of one object
+    """
+    if len(mesh.object_names) < 2:
+        return ()
+    told = set(int(index) for index in told)
+    apart = told | set(int(index) for index in thin)
+    triangles, owner, small = _small_objects(mesh, left_out, told)
+    thick = {index: points for index, points in small.items() if index not in apart}
+    rest = ~np.isin(owner, list(apart))
+    if not thick or not rest.any():
+        return ()
+    near = NEAR_SHARE * largest_side(mesh.vertices[np.unique(triangles[rest])])
+    candidates = []
+    for index, points in sorted(thick.items()):
+        body = triangles[rest & (owner != index)]
+        if not len(body):
+            continue
+        touching = _touching(points, TriangleMeshQuery(mesh.vertices, body), near)
+        if touching is not None:
+            candidates.append(Candidate(index, points, *touching, thin=False))
+    return tuple(candidates)
+
+
+def hand_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
+    """The thin and the thick candidates of ``mesh`` (:func:`thin_candidates`,
+    :func:`thick_candidates`), in the objects' order."""
+    thin = thin_candidates(mesh, left_out, told)
+    thick = thick_candidates(mesh, left_out, told, [candidate.object_index for candidate in thin])
+    return tuple(sorted(thin + thick, key=lambda candidate: candidate.object_index))
+
+
+def own_hands(wrists: dict, elbows: dict, body: np.ndarray, body_size: float) -> dict:
+    """The wrists past which ``body`` (world vertices, without any candidate) goes on, a hand of its own:
+    some vertex within :data:`HAND_REACH` of the body's largest side of the wrist lies at least
+    :data:`HAND_PAST` of it beyond the wrist along the forearm (elbow to wrist). A body whose hands are
+    objects of their own ends at the wrists. Returns a dict mapping each such wrist's name to the
+    forearm's unit direction there."""
+    hands = {}
+    body = np.asarray(body, dtype=np.float64)
+    for name, wrist in wrists.items():
+        elbow = elbows.get(name.replace("wrist", "elbow"))
+        if elbow is None or np.linalg.norm(wrist - elbow) <= 0:
+            continue
+        pointing = (wrist - elbow) / np.linalg.norm(wrist - elbow)
+        offsets = body - wrist
+        near = np.linalg.norm(offsets, axis=1) <= HAND_REACH * body_size
+        if near.any() and (offsets[near] @ pointing).max() >= HAND_PAST * body_size:
+            hands[name] = pointing
+    return hands
+
+
+def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None = None) -> tuple[Prop, ...]:
     """The candidates held at the hands (module docstring, step 2), as held props.
 
     Parameters
     ----------
-    candidates : Candidates (:func:`thin_candidates`)
+    candidates : Candidates (:func:`thin_candidates`, :func:`thick_candidates`)
     wrists : dict mapping ``wrist.L`` and ``wrist.R`` (those found) to (3,) world points
     body_size : float, the largest side of the body without the candidates, scene units
+    hands : dict or None, mapping a thick candidate's object index to :func:`own_hands` of the body
+        without it: the wrists with a hand of the body's own and the forearm's direction there; a thick
+        candidate is held only at one of those, lying past the wrist (in the hand, not around the
+        forearm). None: no thick candidate is held
 
     Returns
     -------
@@ -171,9 +271,14 @@ def held_at_hands(candidates, wrists: dict, body_size: float) -> tuple[Prop, ...
         if np.mean(at_hand) < AT_HAND_SHARE:
             continue
         holding = np.bincount(nearest[at_hand], minlength=len(names)).argmax()
-        beyond = np.linalg.norm(candidate.surface - points[holding], axis=1) > reach
-        if np.mean(beyond) < BEYOND_HAND_SHARE:
-            continue
+        if candidate.thin:
+            beyond = np.linalg.norm(candidate.surface - points[holding], axis=1) > reach
+            if np.mean(beyond) < BEYOND_HAND_SHARE:
+                continue
+        else:
+            pointing = (hands or {}).get(candidate.object_index, {}).get(names[holding])
+            if pointing is None or (candidate.surface.mean(axis=0) - points[holding]) @ pointing <= 0:
+                continue
         grip = candidate.touching[at_hand & (nearest == holding)].mean(axis=0)
         held.append(Prop(candidate.object_index, grip, candidate.gap, True))
     return tuple(held)
@@ -220,11 +325,11 @@ def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(
     reading : BodyReading, or None when no body was read
     """
     if candidates is None:
-        candidates = thin_candidates(mesh, left_out, told)
+        candidates = hand_candidates(mesh, left_out, told)
     if not candidates:
         return (), None
     rows = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
-    for index in {candidate.object_index for candidate in candidates} | set(int(index) for index in told):
+    for index in {candidate.object_index for candidate in candidates if candidate.thin} | set(map(int, told)):
         rows[mesh.object_slice(index)] = False
     body = mesh.subset(rows)
     try:
@@ -237,4 +342,12 @@ def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(
     points = votes.landmarks.points_for(HOLDING_KIND)
     to_mesh = np.linalg.inv(votes.transform)
     wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
-    return held_at_hands(candidates, wrists, largest_side(body.vertices)), reading
+    elbows = {name: apply_transform(points[name], to_mesh)[0] for name in ELBOWS if name in points}
+    size = largest_side(body.vertices)
+    hands = {}
+    for candidate in candidates:
+        if not candidate.thin:  # without it, has the body a hand of its own? (it may be the hand)
+            without = rows.copy()
+            without[mesh.object_slice(candidate.object_index)] = False
+            hands[candidate.object_index] = own_hands(wrists, elbows, mesh.vertices[without], size)
+    return held_at_hands(candidates, wrists, size, hands), reading
