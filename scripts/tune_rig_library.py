@@ -33,7 +33,7 @@ import numpy as np
 from autorig_addon.core.dataset.cache import default_cache_dir, training_samples
 from autorig_addon.core.dataset.normalise import normalisation_transform
 from autorig_addon.core.dataset.sample import CharacterSample
-from autorig_addon.core.dataset.split import DEFAULT_SPLIT_FILE
+from autorig_addon.core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
 from autorig_addon.core.evaluation.key_joint_metrics import KEY_JOINT_FRACTION
 from autorig_addon.core.geometry.proxy import simplified_proxy
 from autorig_addon.core.rigging import rig_library
@@ -49,12 +49,8 @@ LIMITS = (0.0, 0.01, 0.015, 0.02, 0.025, 0.026, 0.03, 0.035, 0.04, 0.05)
 
 
 def near_duplicates(name: str) -> set:
-    groups = json.load(open(DEFAULT_SPLIT_FILE))["near_duplicates"]
-    for group in groups:
-        stems = {os.path.splitext(path)[0] for path in group}
-        if name in stems:
-            return stems
-    return {name}
+    """``name`` and its near-duplicates (``data_split.json``)."""
+    return set(read_data_split(DEFAULT_SPLIT_FILE).near_duplicate_names(name))
 
 
 def held_out_samples() -> list:

@@ -200,6 +200,17 @@ def test_families_of_the_split_map_each_member_to_its_family(tmp_path):
         read_data_split(tmp_path / "bad.json")
 
 
+def test_near_duplicates_of_the_split_name_each_other(tmp_path):
+    groups = [["animals/Horse.glb", "animals/Horse_White.glb"], ["snakes/Snake.glb", "snakes/Snake_angry.glb"]]
+    (tmp_path / "split.json").write_text(json.dumps({**SPLIT, "near_duplicates": groups}))
+    split = read_data_split(tmp_path / "split.json")
+    assert split.near_duplicate_names("animals/Horse_White") == {"animals/Horse", "animals/Horse_White"}
+    assert split.near_duplicate_names("animals/Donkey") == {"animals/Donkey"}
+    (tmp_path / "bad.json").write_text(json.dumps({**SPLIT, "near_duplicates": {"animals": ["animals/Horse.glb"]}}))
+    with pytest.raises(InputError, match="'near_duplicates' must be a list of lists of paths"):
+        read_data_split(tmp_path / "bad.json")
+
+
 def save_sample(folder, name: str) -> None:
     mesh = Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 0, 2]], float), np.array([[0, 1, 2]]))
     skeleton = Skeleton(np.array([[0, 0, 0], [0, 0, 1]], float), [-1, 0], ("hips", "head"))

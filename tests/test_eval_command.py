@@ -317,6 +317,30 @@ def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys,
     assert report["characters"][0]["cd_j2j"] == 0.0
 
 
+def test_a_training_character_is_scored_without_its_own_rig_to_copy(clean_scene, tmp_path, capsys, monkeypatch):
+    """Scored under a training character's name (a Quaternius horse), a rig method sees the shipped rig
+    library without that character and its near-duplicate (the white horse), as for a character the project
+    has never seen; the library is whole again after."""
+    from autorig_addon.core.rigging import rig_library
+
+    horses = {"quaternius_glb/animals_pack/Horse", "quaternius_glb/animals_pack/Horse_White"}
+    whole = set(rig_library.shipped_library().names)
+    assert horses <= whole
+    save_body(tmp_path / "chars" / "quaternius_glb" / "animals_pack" / "Horse.blend")
+    seen = []
+
+    def predict(mesh):
+        seen.append(set(rig_library.shipped_library().names))
+        return SKELETON
+
+    monkeypatch.setitem(evaluation_methods.RIG_METHODS, "library", evaluation_methods.Method(predict, "test"))
+    code, report, _ = run_eval(["rig", str(tmp_path / "chars"), "--method", "library"], tmp_path, capsys)
+
+    assert code == 0 and report["characters"][0]["name"] == "quaternius_glb/animals_pack/Horse"
+    assert seen == [whole - horses]
+    assert set(rig_library.shipped_library().names) == whole
+
+
 def test_json_on_stdout(clean_scene, tmp_path, capsys):
     save_body(tmp_path / "body.blend")
     capsys.readouterr()  # what saving the fixture printed

@@ -337,3 +337,15 @@ def test_a_known_rig_the_checks_find_poor_gives_way_to_the_skeleton_without_it(b
     monkeypatch.setattr(rig_library, "shipped_library", lambda: build_rig_library([sample]))
     sound = predict.checked_skeleton(predict.predict_votes(character.mesh))
     assert sound.known_rig and sound.notes == () and "hair.002" in sound.skeleton.names
+
+
+def test_the_shipped_library_can_leave_characters_out_for_a_while():
+    """shipped_library_without: inside, the shipped library lacks the names (nested: both sets); after, whole."""
+    whole = list(rig_library.shipped_library().names)
+    first, second = whole[0], whole[-1]
+    with rig_library.shipped_library_without({first}):
+        assert list(rig_library.shipped_library().names) == whole[1:]
+        with rig_library.shipped_library_without({first, second}):
+            assert list(rig_library.shipped_library().names) == whole[1:-1]
+        assert list(rig_library.shipped_library().names) == whole[1:]
+    assert list(rig_library.shipped_library().names) == whole

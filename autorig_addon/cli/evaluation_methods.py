@@ -23,6 +23,7 @@ not load Blender.
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -145,7 +146,8 @@ def rig_predictor(method: str) -> Callable:
     predict = RIG_METHODS[method].predict
 
     def predict_rig(mesh, item: DataItem) -> RigPrediction:
-        result = predict(mesh)
+        with itself_left_out(item.name):
+            result = predict(mesh)
         return result if isinstance(result, RigPrediction) else RigPrediction(result)
 
     return predict_rig
@@ -196,6 +198,37 @@ def _skin_method(name: str) -> Callable:
     return predict
 
 
+#: The characters the built-in rig methods may not copy while one is scored (:func:`itself_left_out`).
+_LEFT_OUT: list = [frozenset()]
+
+
+@lru_cache(maxsize=1)
+def _repository_split():
+    """The repository's ``data_split.json`` (``--split-file`` does not reach a registered method), read once."""
+    from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
+
+    return read_data_split(DEFAULT_SPLIT_FILE)
+
+
+@contextmanager
+def itself_left_out(name: str):
+    """Inside, the built-in rig methods copy nothing of the character ``name`` or its near-duplicates
+    (``data_split.json``): not their rigs from the rig library
+    (``core.rigging.rig_library.shipped_library_without``), not their skeletons as the closest
+    character. A validation character and its near-duplicates are in neither, so its score does not
+    change; a training character is scored without its own artist's rig to copy (the networks still
+    trained on it: numbers on training characters stay in-sample)."""
+    from ..core.rigging.rig_library import shipped_library_without
+
+    left_out = _repository_split().near_duplicate_names(name)
+    _LEFT_OUT.append(left_out)
+    try:
+        with shipped_library_without(left_out):
+            yield
+    finally:
+        _LEFT_OUT.pop()
+
+
 @lru_cache(maxsize=1)
 def _nearest_character_pool() -> tuple:
     """The cached samples of the training characters of the repository's
@@ -203,9 +236,9 @@ def _nearest_character_pool() -> tuple:
     read once per process; its validation characters are left out by name
     whatever the cache holds."""
     from ..core.dataset.cache import training_samples
-    from ..core.dataset.split import DEFAULT_SPLIT_FILE, PURPOSE_SKELETON, read_data_split
+    from ..core.dataset.split import PURPOSE_SKELETON
 
-    validation = {os.path.splitext(path)[0] for path in read_data_split(DEFAULT_SPLIT_FILE).validation}
+    validation = {os.path.splitext(path)[0] for path in _repository_split().validation}
     pool = training_samples(purpose=PURPOSE_SKELETON)
     return tuple(sample for sample in pool if sample.name not in validation), frozenset(validation)
 
@@ -214,7 +247,7 @@ def _nearest_character(mesh) -> RigPrediction:
     from ..core.rigging.nearest_character import nearest_character
 
     pool, validation = _nearest_character_pool()
-    chosen = nearest_character(mesh, pool, exclude=validation)
+    chosen = nearest_character(mesh, pool, exclude=validation | _LEFT_OUT[-1])
     return RigPrediction(chosen.skeleton, (chosen.note,))
 
 

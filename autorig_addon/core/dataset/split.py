@@ -54,6 +54,9 @@ class DataSplit:
         Skeleton family (index in the file's ``families`` list) of each
         listed path: characters sharing a rig or a body, which the split
         keeps on one side and training samples evenly.
+    near_duplicates : tuple of frozenset of str
+        Groups of paths whose characters are near-duplicates of one another
+        (the same body and rig in other clothes or colours).
     """
 
     train: tuple
@@ -62,6 +65,15 @@ class DataSplit:
     skeleton_only: dict = field(default_factory=dict)
     excluded: dict = field(default_factory=dict)
     families: dict = field(default_factory=dict)
+    near_duplicates: tuple = ()
+
+    def near_duplicate_names(self, name: str) -> frozenset:
+        """``name`` (a path without extension) and the names of its near-duplicates."""
+        for group in self.near_duplicates:
+            names = frozenset(os.path.splitext(path)[0] for path in group)
+            if name in names:
+                return names
+        return frozenset({name})
 
     def usable_for(self, path: str, purpose: str) -> bool:
         """Whether the character at ``path`` (relative, as listed) may be used
@@ -111,8 +123,12 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
         if not isinstance(value, dict):
             raise InputError(f"'{path.name}': '{key}' must map paths to the reason {meaning}.")
         reasons[key] = {_split_path(entry): str(reason) for entry, reason in value.items()}
+    near_duplicates = document.get("near_duplicates", [])
+    if not isinstance(near_duplicates, list) or not all(isinstance(group, list) for group in near_duplicates):
+        raise InputError(f"'{path.name}': 'near_duplicates' must be a list of lists of paths.")
     return DataSplit(train, validation, _categories(document.get("categories", {})), reasons["skeleton_only"],
-                     reasons["excluded"], _families(document.get("families", []), path.name))
+                     reasons["excluded"], _families(document.get("families", []), path.name),
+                     tuple(frozenset(_split_path(entry) for entry in group) for group in near_duplicates))
 
 
 def _split_path(entry) -> str:

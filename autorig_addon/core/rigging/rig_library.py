@@ -39,6 +39,7 @@ pack retarget onto her by name.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -287,9 +288,33 @@ class KnownRig:
 
 
 @lru_cache(maxsize=1)
-def shipped_library() -> RigLibrary | None:
-    """The shipped library, read once; None when the file is absent (a checkout before ``train library``)."""
+def _loaded_library() -> RigLibrary | None:
+    """The shipped library file, read once; None when it is absent (a checkout before ``train library``)."""
     return RigLibrary.load(LIBRARY_FILE) if LIBRARY_FILE.is_file() else None
+
+
+#: Libraries standing in for the shipped one while :func:`shipped_library_without` runs, innermost last.
+_STAND_INS: list = []
+
+
+def shipped_library() -> RigLibrary | None:
+    """The shipped library (without the characters :func:`shipped_library_without` leaves out, inside it)."""
+    return _STAND_INS[-1] if _STAND_INS else _loaded_library()
+
+
+@contextmanager
+def shipped_library_without(names):
+    """Inside, :func:`shipped_library` lacks the characters ``names`` (paths in the data without
+    extension): scoring a training character (``eval rig``), its own rig and its family's are not
+    there to copy, as for a character the project has never seen."""
+    library = _loaded_library()
+    if library is not None:
+        library = library.subset(~np.isin(library.names, sorted(names)))
+    _STAND_INS.append(library)
+    try:
+        yield
+    finally:
+        _STAND_INS.pop()
 
 
 def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
