@@ -41,7 +41,9 @@ def test_weights_saved_at_half_precision_load_as_float32_rounded_to_it(tmp_path)
     rng = np.random.default_rng(0)
     weights = {
         "mlp.linears.0.weight": rng.normal(size=(64, 32)).astype(np.float32),
-        "norm.running_var": np.array([2.5e6, 1.0], dtype=np.float32),  # beyond float16's 65504: kept whole
+        "wide.weight": np.array([[2.5e6, 1.0]], dtype=np.float32),  # beyond float16's 65504: kept whole
+        # A vector stays whole: a running mean of 1000.3 would round to 1000.5 at half precision.
+        "norm.running_mean": np.array([1000.3, -2.7e-3], dtype=np.float32),
         "norm.num_batches_tracked": np.asarray(12, dtype=np.int64),
     }
     full, half = str(tmp_path / "full.npz"), str(tmp_path / "half.npz")
@@ -50,11 +52,14 @@ def test_weights_saved_at_half_precision_load_as_float32_rounded_to_it(tmp_path)
     loaded = load_weights(half)
     assert loaded.metadata == {"model": "tiny"}
     assert {name: array.dtype for name, array in loaded.weights.items()} == {
-        "mlp.linears.0.weight": np.float32, "norm.running_var": np.float32, "norm.num_batches_tracked": np.int64}
+        "mlp.linears.0.weight": np.float32, "wide.weight": np.float32, "norm.running_mean": np.float32,
+        "norm.num_batches_tracked": np.int64}
     matrix = weights["mlp.linears.0.weight"]
     assert np.array_equal(loaded.weights["mlp.linears.0.weight"], matrix.astype(np.float16).astype(np.float32))
     assert 0 < np.abs(loaded.weights["mlp.linears.0.weight"] - matrix).max() <= 2.0 ** -11 * np.abs(matrix).max()
-    assert np.array_equal(loaded.weights["norm.running_var"], weights["norm.running_var"])
+    assert np.array_equal(loaded.weights["wide.weight"], weights["wide.weight"])
+    assert np.array_equal(loaded.weights["norm.running_mean"], weights["norm.running_mean"])
+    assert np.float16(1000.3) == 1000.5
     assert loaded.weights["norm.num_batches_tracked"] == 12
     # 2,048 numbers at two bytes instead of four: the file is about half as large.
     assert os.path.getsize(half) < 0.6 * os.path.getsize(full)

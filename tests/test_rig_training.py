@@ -95,11 +95,13 @@ def test_written_weights_are_what_the_predictor_reads(examples, tmp_path):
     weights, record = run("root", examples, seed=0, epochs=3)
     path = write_weights(RIG_NETWORKS["root"], weights, record, tmp_path / "root.npz")
     loaded = load_weights(str(path))
-    # Saved at half precision: each weight rounded to float16 and read back as float32; the rest as they were.
+    # Saved at half precision: each weight matrix rounded to float16 and read back as float32; the rest (vectors
+    # such as biases and feature means, integers) as they were.
     assert loaded.weights.keys() == weights.keys()
     for name, value in weights.items():
         value = np.asarray(value)
-        expected = value.astype(np.float16).astype(np.float32) if value.dtype.kind == "f" else value
+        halved = value.dtype.kind == "f" and value.ndim >= 2
+        expected = value.astype(np.float16).astype(np.float32) if halved else value
         assert np.array_equal(loaded.weights[name], expected), name
     assert loaded.metadata["network"] == "root" and loaded.metadata["epochs"] == 3
     assert loaded.metadata["holdout_accuracy"] == record.details["holdout_accuracy"]

@@ -57,10 +57,13 @@ def _current_umask() -> int:
 
 
 def _at_half_precision(array: np.ndarray) -> np.ndarray:
-    """``array`` as float16 when it is floating point and float16 holds its
-    every value finitely; as it is otherwise (integers, flags, and the rare
-    array beyond float16's range of 65504, such as a running variance)."""
-    if array.dtype.kind != "f" or array.dtype.itemsize <= 2:
+    """``array`` as float16 when it is a floating-point matrix (two axes or
+    more) and float16 holds its every value finitely; as it is otherwise
+    (integers, flags, the rare matrix beyond float16's range of 65504).
+    Vectors stay whole: biases and a normalisation's running mean and
+    variance are a sliver of a network's size, and a mean subtracted from
+    features of small variance would carry its rounding into every output."""
+    if array.dtype.kind != "f" or array.dtype.itemsize <= 2 or array.ndim < 2:
         return array
     with np.errstate(over="ignore"):  # an overflow is what the test below catches
         halved = array.astype(np.float16)
@@ -79,8 +82,8 @@ def save_weights(path: str, weights: dict, metadata: Optional[dict] = None, half
     metadata : dict, optional
         JSON-serialisable settings saved beside the arrays.
     half_precision : bool
-        Store floating-point arrays as float16 where it holds them
-        (:func:`_at_half_precision`); they load back as float32.
+        Store floating-point matrices as float16 where it holds them
+        (:func:`_at_half_precision`; vectors stay whole); they load back as float32.
 
     Raises
     ------
