@@ -5,7 +5,9 @@ half precision (``core/nn/weights_io.py``); this rewrites the weights trained
 before that change the same way, metadata kept, so the shipped files need no
 retraining to shrink. It prints each file's size before and after and the
 largest rounding error relative to each array's largest value. A file
-already at half precision is rewritten unchanged.
+already at half precision keeps its values (its vectors, halved before
+2026-12-07's evening, are then stored at full precision as training now
+writes them: the same numbers, a few kilobytes more).
 
     .venv/bin/python scripts/halve_shipped_weights.py
 """

@@ -318,15 +318,16 @@ def test_registered_rig_method_sees_only_the_mesh(clean_scene, tmp_path, capsys,
 
 
 def test_a_training_character_is_scored_without_its_own_rig_to_copy(clean_scene, tmp_path, capsys, monkeypatch):
-    """Scored under a training character's name (a Quaternius horse), a rig method sees the shipped rig
-    library without that character and its near-duplicate (the white horse), as for a character the project
-    has never seen; the library is whole again after."""
+    """Scored as a training character's file (a Quaternius horse, found by the split's path whatever folder
+    ``eval`` is given), a rig method sees the shipped rig library without that character and its
+    near-duplicate (the white horse), as for a character the project has never seen; the library is whole
+    again after."""
     from autorig_addon.core.rigging import rig_library
 
     horses = {"quaternius_glb/animals_pack/Horse", "quaternius_glb/animals_pack/Horse_White"}
     whole = set(rig_library.shipped_library().names)
     assert horses <= whole
-    save_body(tmp_path / "chars" / "quaternius_glb" / "animals_pack" / "Horse.blend")
+    save_body(tmp_path / "chars" / "quaternius_glb" / "animals_pack" / "Horse.glb")
     seen = []
 
     def predict(mesh):
@@ -334,11 +335,24 @@ def test_a_training_character_is_scored_without_its_own_rig_to_copy(clean_scene,
         return SKELETON
 
     monkeypatch.setitem(evaluation_methods.RIG_METHODS, "library", evaluation_methods.Method(predict, "test"))
-    code, report, _ = run_eval(["rig", str(tmp_path / "chars"), "--method", "library"], tmp_path, capsys)
+    code, report, _ = run_eval(["rig", str(tmp_path / "chars" / "quaternius_glb"), "--method", "library"], tmp_path,
+                               capsys)
 
-    assert code == 0 and report["characters"][0]["name"] == "quaternius_glb/animals_pack/Horse"
+    assert code == 0 and report["characters"][0]["name"] == "animals_pack/Horse"
     assert seen == [whole - horses]
     assert set(rig_library.shipped_library().names) == whole
+
+
+def test_a_file_the_split_does_not_name_or_no_split_leaves_nothing_out(tmp_path, monkeypatch):
+    """A file outside the split, or an installed extension without data_split.json: the library stays whole."""
+    from autorig_addon.core.rigging import rig_library
+
+    whole = list(rig_library.shipped_library().names)
+    with evaluation_methods.itself_left_out(tmp_path / "elsewhere" / "Body.glb"):
+        assert list(rig_library.shipped_library().names) == whole
+    monkeypatch.setattr(evaluation_methods, "_repository_split", lambda: None)
+    with evaluation_methods.itself_left_out(tmp_path / "quaternius_glb" / "animals_pack" / "Horse.glb"):
+        assert list(rig_library.shipped_library().names) == whole
 
 
 def test_json_on_stdout(clean_scene, tmp_path, capsys):

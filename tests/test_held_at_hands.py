@@ -8,7 +8,9 @@ from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging.held_at_hands import (
     AT_HAND_SHARE,
     HAND_PAST,
+    HAND_RADIUS,
     HAND_REACH,
+    HELD_PAST,
     THIN_RATIO,
     Candidate,
     hand_candidates,
@@ -127,9 +129,13 @@ def test_a_body_goes_on_past_a_wrist_only_where_it_has_a_hand_of_its_own():
     hands = own_hands(wrists, elbows, np.vstack([forearms, left_hand]), size)
     assert list(hands) == ["wrist.L"]
     np.testing.assert_allclose(hands["wrist.L"], [1.0, 0.0, 0.0])
-    # Short of HAND_PAST, or with no elbow to tell the forearm's direction: no hand.
+    # Short of HAND_PAST, off the forearm's line (a thigh beside a hanging hand), or with no elbow to tell the
+    # forearm's direction: no hand.
     short = np.array([[0.5 + 0.8 * HAND_PAST * size, 0.0, 1.0]])
     assert own_hands(wrists, elbows, np.vstack([forearms, short]), size) == {}
+    beside = np.array([[0.5 + past, 0.0, 1.0 - 1.2 * HAND_RADIUS * size]])
+    assert np.linalg.norm(beside[0] - wrists["wrist.L"]) <= HAND_REACH * size
+    assert own_hands(wrists, elbows, np.vstack([forearms, beside]), size) == {}
     assert own_hands(wrists, {}, np.vstack([forearms, left_hand]), size) == {}
 
 
@@ -146,11 +152,12 @@ def test_a_thick_candidate_is_held_only_in_a_hand_of_the_bodys_own_and_past_the_
     cuff = Candidate(2, wrists["wrist.R"] + [0.08, 0.0, 0.0] + rng.uniform(-0.04, 0.04, (200, 3)), at_right,
                      0.0, thin=False)
     right_hand = {"wrist.R": np.array([-1.0, 0.0, 0.0])}
-    props = held_at_hands([mug, cuff], wrists, size, {1: right_hand, 2: right_hand})
+    assert 0.08 > HELD_PAST * size
+    props = held_at_hands([mug, cuff], wrists, size, right_hand)
     assert [prop.object_index for prop in props] == [1]
     np.testing.assert_allclose(props[0].grip, at_right.mean(axis=0))
     # Without a hand of the body's own there (the object may be the hand), or not told: not held.
-    assert held_at_hands([mug], wrists, size, {1: {"wrist.L": np.array([1.0, 0.0, 0.0])}}) == ()
+    assert held_at_hands([mug], wrists, size, {"wrist.L": np.array([1.0, 0.0, 0.0])}) == ()
     assert held_at_hands([mug], wrists, size) == ()
 
 
@@ -167,13 +174,16 @@ def test_the_procedural_bipeds_mirrored_mugs_are_thick_candidates_held_in_its_ha
     np.testing.assert_allclose(props[1].grip, [0.289, -0.011, 0.558], atol=0.02)
 
 
-def test_hands_that_are_objects_of_their_own_are_not_held():
-    """The biped's hands and the ends of its forearms cut off into objects of their own (x beyond 0.21;
+@pytest.mark.parametrize("holding", [False, True], ids=["empty", "holding a ball"])
+def test_hands_that_are_objects_of_their_own_are_not_held(holding):
+    """The biped's hands with the ends of its forearms cut off into objects of their own (x beyond 0.19;
     the wrists lie near 0.26): thick candidates at the wrists, but without them the body ends short of
-    the wrists, so they are the hands, not what the hands hold."""
+    the wrists, so they are the hands, not what the hands hold. A ball (4 cm) at the right hand's
+    fingertips changes nothing: asked without every thick object at a wrist (the hand and the ball
+    alike), the body has no hand of its own there, so neither is held."""
     character = generate_character(0, "biped").mesh
     vertices, triangles = character.vertices, character.triangles
-    cut = (np.abs(vertices[triangles][:, :, 0]) > 0.21).all(axis=1)
+    cut = (np.abs(vertices[triangles][:, :, 0]) > 0.19).all(axis=1)
     side = np.sign(vertices[triangles[:, 0], 0])
 
     def piece(mask, name):
@@ -182,7 +192,10 @@ def test_hands_that_are_objects_of_their_own_are_not_held():
         index[used] = np.arange(len(used))
         return Mesh(vertices[used], index[triangles[mask]], object_names=(name,))
 
-    mesh = Mesh.concatenate([piece(~cut, "Body"), piece(cut & (side < 0), "Hand.R"),
-                             piece(cut & (side > 0), "Hand.L")])
-    assert [candidate.object_index for candidate in thick_candidates(mesh)] == [1, 2]
+    objects = [piece(~cut, "Body"), piece(cut & (side < 0), "Hand.R"), piece(cut & (side > 0), "Hand.L")]
+    if holding:
+        ball = box_mesh((-0.34, -0.02, 0.55), (-0.30, 0.02, 0.59), 0.005)
+        objects.append(Mesh(ball.vertices, ball.triangles, object_names=("Ball",)))
+    mesh = Mesh.concatenate(objects)
+    assert [candidate.object_index for candidate in thick_candidates(mesh)] == ([1, 2, 3] if holding else [1, 2])
     assert props_held_at_hands(mesh) == ()

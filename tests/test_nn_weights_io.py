@@ -59,7 +59,6 @@ def test_weights_saved_at_half_precision_load_as_float32_rounded_to_it(tmp_path)
     assert 0 < np.abs(loaded.weights["mlp.linears.0.weight"] - matrix).max() <= 2.0 ** -11 * np.abs(matrix).max()
     assert np.array_equal(loaded.weights["wide.weight"], weights["wide.weight"])
     assert np.array_equal(loaded.weights["norm.running_mean"], weights["norm.running_mean"])
-    assert np.float16(1000.3) == 1000.5
     assert loaded.weights["norm.num_batches_tracked"] == 12
     # 2,048 numbers at two bytes instead of four: the file is about half as large.
     assert os.path.getsize(half) < 0.6 * os.path.getsize(full)

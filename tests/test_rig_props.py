@@ -13,7 +13,7 @@ import pytest
 
 from autorig_addon.blender import convert, scene_io
 from autorig_addon.blender.armature_builder import build_armature
-from autorig_addon.blender.jobs.rig import HANDS_READING_LABEL, plan_rig_steps, planned_rig_steps
+from autorig_addon.blender.jobs.rig import HANDS_READING_LABEL, plan_rig_steps, planned_rig_steps, run_steps
 from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.cli.main import main
 from autorig_addon.core.errors import Cancelled
@@ -517,25 +517,32 @@ def test_planning_reads_the_body_for_the_swords_in_a_task_of_its_own(clean_scene
     assert plan.meshes == [body]
 
 
-def test_cancelling_while_the_hands_are_read_builds_nothing(clean_scene):
-    """Esc during that reading (Cancelled thrown in at its task, as the
-    operator's worker does) ends the run with the scene as it was."""
+def test_esc_while_the_hands_are_read_stops_the_run_with_the_scene_as_it_was(clean_scene):
+    """Esc during that reading: the worker's progress callback raises Cancelled inside the landmark network's
+    reading (as the operators' worker does at its next report); the run stops there, nothing is built and
+    the scene is as it was."""
     body = add_biped()
     sword, offhand = add_mirrored_swords()
     before = scene_state([body, sword, offhand])
+    reported = []
+
+    def escape(fraction, message):
+        reported.append(message)
+        if message.startswith(HANDS_READING_LABEL) and "network" in message:
+            raise Cancelled()
+
     steps = planned_rig_steps(bpy.context, plan_rig_steps([body, sword, offhand],
                                                           bpy.context.evaluated_depsgraph_get(), "Biped",
                                                           skin=SkinSettings()))
-    next(steps)
-
     with pytest.raises(Cancelled):
-        steps.throw(Cancelled())
+        run_steps(steps, escape)
+    assert any("network" in message for message in reported)
     assert armatures() == []
     assert scene_state([body, sword, offhand]) == before
 
 
-def test_a_body_holding_nothing_thin_is_planned_without_a_task(clean_scene, monkeypatch):
-    """Without a thin object to tell, planning yields no task and reads no body."""
+def test_a_single_mesh_is_planned_without_a_task(clean_scene, monkeypatch):
+    """A character of one object has nothing of its own to hold: planning yields no task and reads no body."""
     readings = counted_readings(monkeypatch)
     body = add_biped()
 

@@ -146,7 +146,7 @@ def rig_predictor(method: str) -> Callable:
     predict = RIG_METHODS[method].predict
 
     def predict_rig(mesh, item: DataItem) -> RigPrediction:
-        with itself_left_out(item.name):
+        with itself_left_out(item.path):
             result = predict(mesh)
         return result if isinstance(result, RigPrediction) else RigPrediction(result)
 
@@ -204,23 +204,28 @@ _LEFT_OUT: list = [frozenset()]
 
 @lru_cache(maxsize=1)
 def _repository_split():
-    """The repository's ``data_split.json`` (``--split-file`` does not reach a registered method), read once."""
+    """The repository's ``data_split.json`` (``--split-file`` does not reach a registered method), read
+    once; None where there is none (an installed extension)."""
     from ..core.dataset.split import DEFAULT_SPLIT_FILE, read_data_split
 
-    return read_data_split(DEFAULT_SPLIT_FILE)
+    return read_data_split(DEFAULT_SPLIT_FILE) if DEFAULT_SPLIT_FILE.is_file() else None
 
 
 @contextmanager
-def itself_left_out(name: str):
-    """Inside, the built-in rig methods copy nothing of the character ``name`` or its near-duplicates
-    (``data_split.json``): not their rigs from the rig library
-    (``core.rigging.rig_library.shipped_library_without``), not their skeletons as the closest
-    character. A validation character and its near-duplicates are in neither, so its score does not
-    change; a training character is scored without its own artist's rig to copy (the networks still
-    trained on it: numbers on training characters stay in-sample)."""
+def itself_left_out(path: Path):
+    """Inside, the built-in rig methods copy nothing of the character in the file ``path`` or its
+    near-duplicates (``data_split.json``, which names the file whatever folder ``eval`` was given):
+    not their rigs from the rig library (``core.rigging.rig_library.shipped_library_without``), not
+    their skeletons as the closest character. A validation character and its near-duplicates are in
+    neither, so its score does not change; a training character is scored without its own artist's
+    rig to copy (the networks still trained on it: numbers on training characters stay in-sample). A
+    file the split does not name (or no split) leaves nothing out."""
+    from ..core.dataset.split import split_entry
     from ..core.rigging.rig_library import shipped_library_without
 
-    left_out = _repository_split().near_duplicate_names(name)
+    split = _repository_split()
+    entry = split_entry(Path(path), split)
+    left_out = split.near_duplicate_names(os.path.splitext(entry)[0]) if entry is not None else frozenset()
     _LEFT_OUT.append(left_out)
     try:
         with shipped_library_without(left_out):
@@ -236,9 +241,9 @@ def _nearest_character_pool() -> tuple:
     read once per process; its validation characters are left out by name
     whatever the cache holds."""
     from ..core.dataset.cache import training_samples
-    from ..core.dataset.split import PURPOSE_SKELETON
+    from ..core.dataset.split import DEFAULT_SPLIT_FILE, PURPOSE_SKELETON, read_data_split
 
-    validation = {os.path.splitext(path)[0] for path in _repository_split().validation}
+    validation = {os.path.splitext(path)[0] for path in read_data_split(DEFAULT_SPLIT_FILE).validation}
     pool = training_samples(purpose=PURPOSE_SKELETON)
     return tuple(sample for sample in pool if sample.name not in validation), frozenset(validation)
 

@@ -39,7 +39,7 @@ from ...core.geometry.outliers import require_finite_positions
 from ...core.messages import listed_names
 from ...core.progress import ProgressCallback, labelled_progress, sub_progress
 from ...core.rigging.character_parts import CharacterParts, character_parts, left_out_notes, several_characters_message
-from ...core.rigging.held_at_hands import BodyReading, hand_candidates, held_at_hands_reading
+from ...core.rigging.held_at_hands import BodyReading, props_held_at_hands_reading
 from ...core.rigging.predict import (
     DEFAULT_FINGERS,
     DEFAULT_TEMPLATE,
@@ -267,11 +267,13 @@ def plan_rig_steps(meshes: list, depsgraph, name: str, settings: RigSettings = R
     """Read and check the character's meshes, as steps (see :func:`rig_steps`) that return the
     plan; raises :class:`InputError` on bad input.
 
-    The steps yield one task at most: the landmark network reading the body
-    to tell thin objects held at the hands (``core.rigging.held_at_hands``),
-    only when the character has such a candidate. The operators run it in
-    the worker like the prediction (progress, Esc), not while the operator
-    starts; the rest reads Blender's objects and is quick.
+    The steps yield one task at most, for a character of several objects:
+    telling the objects it holds at its hands (``core.rigging.held_at_hands``:
+    the candidates, then the landmark network reading the body when there is
+    one). The operators run it in the worker like the prediction (progress,
+    Esc), not while the operator starts; the rest reads Blender's objects and
+    is quick, and its refusals (a mesh already bound, several characters)
+    come before it.
 
     What is not the character (``core.rigging.character_parts``) is told
     apart here: a ground plane and stray specks are left out (a mesh wholly
@@ -315,40 +317,80 @@ def plan_rig_steps(meshes: list, depsgraph, name: str, settings: RigSettings = R
     if rigify and settings.template == FREE_FORM:
         raise InputError("Rigify needs a standard skeleton: choose the Auto, Biped or Quadruped template.")
     chosen = meshes
-    meshes, mesh, left_out, notes, held, held_pieces, reading = yield from _the_character(
-        chosen, mesh, named=named, bound=skin is not None, carried=carried)
+    parts, props = _told_apart(chosen, mesh, named=named, carried=carried)
+    if skin is not None and not replace:
+        # What the hands hold moves from the meshes to the held objects, so these are the objects bound either way.
+        _require_unbound([obj for index, obj in enumerate(chosen) if index not in _dropped(parts, props)]
+                         + [chosen[prop.object_index] for prop in props if prop.held and prop.piece is None])
+    told_objects = [prop.object_index for prop in props if prop.piece is None]
+    at_hands, reading = (yield lambda progress: props_held_at_hands_reading(
+        mesh, parts.left_out, told_objects, progress=labelled_progress(progress, HANDS_READING_LABEL))
+    ) if len(mesh.object_names) > 1 else ((), None)
+    meshes, mesh, left_out, notes, held, held_pieces = _settled(chosen, mesh, parts, props + at_hands,
+                                                                bound=skin is not None)
     if name in {obj.name for obj in chosen} - {obj.name for obj in meshes}:
         name = meshes[0].name  # a mesh left out (a ground plane active in the selection) does not name the armature
-    if skin is not None and not replace:
-        bound = [(obj, bound_armature(obj)) for obj in meshes + [obj for obj, _ in held]
-                 if bound_armature(obj) is not None]
-        if bound:
-            obj, armature = bound[0]
-            raise InputError(
-                f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
-                "it to the new skeleton instead, or remove its Armature modifier first."
-            )
     plan = RigPlan(meshes, mesh, name + ARMATURE_SUFFIX, settings, skin, replace, named, rigify, keep_poor,
                    left_out, notes, held, held_pieces, reading)
     _require_not_flat(meshes, plan.character)
     return plan
 
 
-def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool,
-                   carried: dict | None = None) -> Generator[Task, object, tuple]:
-    """Tell the character from what is not (``core.rigging.character_parts``,
-    ``core.rigging.props``): refuse several characters, naming them; leave
-    out a ground plane, stray specks and rigid props. Steps: yields the
-    reading of the body that tells the thin objects held at the hands as a
-    task when there is a candidate, and returns the tuple below.
+def _require_unbound(objects) -> None:
+    """Refuse when one of ``objects`` is already bound to an armature (without Replace Binding)."""
+    bound = [(obj, bound_armature(obj)) for obj in objects if bound_armature(obj) is not None]
+    if bound:
+        obj, armature = bound[0]
+        raise InputError(
+            f"'{obj.name}' is already bound to the armature '{armature.name}': turn on Replace Binding to bind "
+            "it to the new skeleton instead, or remove its Armature modifier first."
+        )
+
+
+def _told_apart(meshes: list, mesh: Mesh, *, named: bool, carried: dict | None = None) -> tuple:
+    """Tell the character from what is not (``core.rigging.character_parts``, ``core.rigging.props``):
+    refuse several characters, naming them; find a ground plane, stray specks and the rigid props told
+    by their lacking a twin or by the rig being replaced. Quick: no network runs. What the hands hold
+    is told after (:func:`props_held_at_hands_reading`).
 
     Parameters
     ----------
     meshes : list of bpy.types.Object
     mesh : Mesh, their rest shape (objects in the order of ``meshes``)
     named : bool, see :class:`RigPlan`
+    carried : dict or None, see :func:`plan_rig_steps`
+
+    Returns
+    -------
+    parts : CharacterParts
+    props : tuple of Prop
+    """
+    parts = character_parts(mesh)
+    if parts.several:
+        raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
+    on_bones = {index: carried[obj] for index, obj in enumerate(meshes) if carried and obj in carried}
+    told = carried_props(mesh, on_bones) if on_bones else ()
+    props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
+                  if prop.object_index not in {known.object_index for known in told}) + told
+    return parts, props
+
+
+def _dropped(parts: CharacterParts, props: tuple) -> set:
+    """The objects not bound with the character: those wholly left out and the props of their own."""
+    return set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
+
+
+def _settled(meshes: list, mesh: Mesh, parts: CharacterParts, props: tuple, *, bound: bool) -> tuple:
+    """The character without what is not, once every prop is told (:func:`_told_apart`, then those
+    held at the hands).
+
+    Parameters
+    ----------
+    meshes : list of bpy.types.Object
+    mesh : Mesh, their rest shape (objects in the order of ``meshes``)
+    parts : CharacterParts
+    props : tuple of Prop, all of them
     bound : bool, the run binds the meshes (the notes say what is left unbound)
-    carried : dict or None, see :func:`plan_rig`
 
     Returns
     -------
@@ -359,23 +401,8 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool,
     held : tuple of (bpy.types.Object, (3,) array), the props held and their grip (see :class:`RigPlan`)
     held_pieces : tuple of ((k,) int array, (3,) array), the props joined into a mesh: their rows in the
         returned mesh and their grip (see :class:`RigPlan`)
-    reading : BodyReading or None, the body read to tell props held at the hands (see :class:`RigPlan`)
     """
-    parts = character_parts(mesh)
-    if parts.several:
-        raise InputError(several_characters_message(mesh, parts, _one_at_a_time(mesh, parts, named)))
-    on_bones = {index: carried[obj] for index, obj in enumerate(meshes) if carried and obj in carried}
-    told = carried_props(mesh, on_bones) if on_bones else ()
-    props = tuple(prop for prop in rigid_props(mesh, parts.left_out)
-                  if prop.object_index not in {known.object_index for known in told}) + told
-    # Twins or props across the mirror plane: held when they touch the body at its hands, which takes a reading.
-    told_objects = [prop.object_index for prop in props if prop.piece is None]
-    candidates = hand_candidates(mesh, parts.left_out, told_objects)
-    at_hands, reading = (yield lambda progress: held_at_hands_reading(
-        mesh, parts.left_out, told_objects, candidates=candidates,
-        progress=labelled_progress(progress, HANDS_READING_LABEL))) if candidates else ((), None)
-    props += at_hands
-    dropped = set(parts.whole_objects()) | {prop.object_index for prop in props if prop.piece is None}
+    dropped = _dropped(parts, props)
     kept_rows = np.ones(mesh.vertex_count, dtype=bool)
     for index in dropped:
         kept_rows[mesh.object_slice(index)] = False
@@ -385,7 +412,7 @@ def _the_character(meshes: list, mesh: Mesh, *, named: bool, bound: bool,
     new_row = np.cumsum(kept_rows) - 1
     held_pieces = tuple((new_row[prop.piece], prop.grip) for prop in props if prop.piece is not None)
     return ([obj for index, obj in enumerate(meshes) if index not in dropped], mesh.subset(kept_rows),
-            left_out if left_out.any() else None, notes, held, held_pieces, reading)
+            left_out if left_out.any() else None, notes, held, held_pieces)
 
 
 def _one_at_a_time(mesh: Mesh, parts: CharacterParts, named: bool) -> str:

@@ -251,7 +251,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
         else:
             raise InputError(f"'{text}' is neither a file nor a folder.")
         for path, name in zip(files, names):
-            entry = _split_entry(path, split)
+            entry = split_entry(path, split)
             if split_name != "all" and entry not in wanted:
                 continue
             if entry is not None and not split.usable_for(entry, purpose):
@@ -271,7 +271,7 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     return items
 
 
-def _split_entry(path: Path, split: Optional[DataSplit]) -> Optional[str]:
+def split_entry(path: Path, split: Optional[DataSplit]) -> Optional[str]:
     """The split's relative path naming ``path`` (the longest that ends it), if any."""
     if split is None:
         return None

@@ -8,7 +8,7 @@ does not tell such a pair from the body's own twinned parts (KayKit's arms
 and legs are objects of their own, wings and ears are thin and stick out);
 where they touch the body does. Here:
 
-1. **candidates** (:func:`thin_candidates`): objects that are small (under
+1. **candidates** (:func:`hand_candidates`; :func:`thin_candidates`): objects that are small (under
    :data:`.props.PROP_AREA_SHARE` of the rest's area), **thin** (their
    smallest extent along their principal axes under :data:`THIN_RATIO` of
    their largest: a blade, a staff, a shield, a bow; not an arm, a leg, a
@@ -16,7 +16,7 @@ where they touch the body does. Here:
    of their area farther than :data:`.props.NEAR_SHARE` of its largest
    side) and touching it (within that distance somewhere);
 2. **held at the hands** (:func:`held_at_hands`): the landmark network reads
-   the body without the candidates; a candidate is held when most of where
+   the body without the thin candidates; a candidate is held when most of where
    it touches the body (:data:`AT_HAND_SHARE`) lies within
    :data:`HAND_REACH` of the body's largest side of a wrist, on a body read
    as a biped (surely, or by its nearest known body), and most of it reaches beyond that
@@ -28,11 +28,13 @@ where they touch the body does. Here:
 A small object that is not thin (a mug, a lantern, a ball: **thick**,
 :func:`thick_candidates`) may be a body part of its own as well (KayKit's
 arms, legs and heads, a hand, a foot), so it stays in the body the network
-reads, and it is held only in a hand of the body's own: the body without it
-goes on at least :data:`HAND_PAST` of its largest side past the wrist along
-the forearm (:func:`own_hands`; a hand of its own leaves the body ending at
-the wrist), and the object's surface lies past the wrist on the whole (in
-the hand, not a cuff around the forearm).
+reads, and it is held only in a hand of the body's own: the body without the
+thick objects at its wrists (a hand of its own and what that hand holds
+alike) goes on at least :data:`HAND_PAST` of its largest side past the wrist
+along the forearm (:func:`own_hands`; a hand of its own leaves the body
+ending at the wrist), and the object's surface lies on the whole at least
+:data:`HELD_PAST` past the wrist (in the hand, not a cuff around the
+forearm).
 
 The caller binds what is held wholly to the bone nearest its grip, the
 mean of where it touches the body near the wrist that holds most of it (a
@@ -51,7 +53,7 @@ from ..errors import InputError
 from ..geometry.bounding_box import largest_side
 from ..geometry.closest_point import TriangleMeshQuery
 from ..geometry.normals import triangle_double_areas
-from ..progress import ProgressCallback
+from ..progress import ProgressCallback, report
 from ..types import Mesh
 from .nearest_character import surface_points
 from .networks.landmarks import BODY_KINDS
@@ -75,15 +77,20 @@ BEYOND_HAND_SHARE = 0.5
 WRISTS = ("wrist.L", "wrist.R")
 ELBOWS = ("elbow.L", "elbow.R")
 #: A hand of the body's own goes on at least this share of the body's largest side past its wrist (a
-#: human hand: about 0.05 of the height); a thick candidate is held only in such a hand.
+#: human hand: about 0.05 of the height), within :data:`HAND_RADIUS` of the forearm's line; a thick
+#: candidate is held only in such a hand ...
 HAND_PAST = 0.03
+HAND_RADIUS = 0.04
+#: ... and only when its surface lies on the whole at least this share past the wrist: a mug in the fist
+#: (0.06 on the procedural biped), not a cuff or a bracelet at the wrist.
+HELD_PAST = 0.015
 #: Only a body read as a biped (surely, or by its nearest known body) has hands to hold with.
 HOLDING_KIND = BODY_KINDS[0]
 
 
 @dataclass(frozen=True, eq=False)
 class Candidate:
-    """An object of the character that may be held (:func:`thin_candidates`, :func:`thick_candidates`).
+    """An object of the character that may be held (:func:`hand_candidates`).
 
     Attributes
     ----------
@@ -145,8 +152,11 @@ def _touching(points: np.ndarray, query: TriangleMeshQuery, near: float) -> tupl
     return None
 
 
-def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
-    """The thin objects of ``mesh`` that may be props held at the hands (module docstring, step 1).
+def hand_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
+    """The objects of ``mesh`` that may be props held at the hands (module docstring, step 1): small,
+    sticking out of the rest and touching it; thin ones (a blade, a staff, a shield) measured against the
+    body without every thin object, thick ones (a mug; ``thin`` False) each against the body without it
+    (they stay in the body the landmark network reads).
 
     Parameters
     ----------
@@ -164,68 +174,53 @@ def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> 
     told = set(int(index) for index in told)
     triangles, owner, small = _small_objects(mesh, left_out, told)
     thin = {index: points for index, points in small.items() if thinness(points) < THIN_RATIO}
-    body = triangles[~np.isin(owner, list(told | set(thin)))]
-    if not thin or not len(body):
-        return ()
-    near = NEAR_SHARE * largest_side(mesh.vertices[np.unique(body)])
-    query = TriangleMeshQuery(mesh.vertices, body)
-    candidates = []
-    for index, points in sorted(thin.items()):
-        touching = _touching(points, query, near)
-        if touching is not None:
-            candidates.append(Candidate(index, points, *touching))
-    return tuple(candidates)
-
-
-def thick_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=(), thin=()) -> tuple[Candidate, ...]:
-    """The small objects of ``mesh`` that are not thin and may be held at the hands all the same (a mug,
-    a lantern, a ball; module docstring): small, sticking out of the rest and touching it. Unlike thin
-    ones they stay in the body the landmark network reads (KayKit's arms, legs and heads are such objects
-    of their own); each is measured against the body without it.
-
-    Parameters
-    ----------
-    mesh, left_out, told : as for :func:`thin_candidates`
-    thin : indices of the thin candidates (:func:`thin_candidates`), not the body
-
-    Returns
-    -------
-    tuple of Candidate (``thin`` False) in the objects' order; empty for a mesh of one object
-    """
-    if len(mesh.object_names) < 2:
-        return ()
-    told = set(int(index) for index in told)
-    apart = told | set(int(index) for index in thin)
-    triangles, owner, small = _small_objects(mesh, left_out, told)
-    thick = {index: points for index, points in small.items() if index not in apart}
-    rest = ~np.isin(owner, list(apart))
-    if not thick or not rest.any():
+    rest = ~np.isin(owner, list(told | set(thin)))
+    if not small or not rest.any():
         return ()
     near = NEAR_SHARE * largest_side(mesh.vertices[np.unique(triangles[rest])])
     candidates = []
-    for index, points in sorted(thick.items()):
+    if thin:
+        query = TriangleMeshQuery(mesh.vertices, triangles[rest])
+        for index, points in thin.items():
+            touching = _touching(points, query, near)
+            if touching is not None:
+                candidates.append(Candidate(index, points, *touching))
+    for index, points in small.items():
         body = triangles[rest & (owner != index)]
-        if not len(body):
+        if index in thin or not len(body):
             continue
         touching = _touching(points, TriangleMeshQuery(mesh.vertices, body), near)
         if touching is not None:
             candidates.append(Candidate(index, points, *touching, thin=False))
-    return tuple(candidates)
+    return tuple(sorted(candidates, key=lambda candidate: candidate.object_index))
 
 
-def hand_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
-    """The thin and the thick candidates of ``mesh`` (:func:`thin_candidates`,
-    :func:`thick_candidates`), in the objects' order."""
-    thin = thin_candidates(mesh, left_out, told)
-    thick = thick_candidates(mesh, left_out, told, [candidate.object_index for candidate in thin])
-    return tuple(sorted(thin + thick, key=lambda candidate: candidate.object_index))
+def thin_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
+    """The thin ones of :func:`hand_candidates`."""
+    return tuple(candidate for candidate in hand_candidates(mesh, left_out, told) if candidate.thin)
+
+
+def thick_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
+    """The thick ones of :func:`hand_candidates` (a mug, a lantern, a ball, but also KayKit's arms and legs)."""
+    return tuple(candidate for candidate in hand_candidates(mesh, left_out, told) if not candidate.thin)
+
+
+def at_a_wrist(candidate: Candidate, wrists: dict, body_size: float) -> bool:
+    """Whether most of where ``candidate`` touches the body (:data:`AT_HAND_SHARE`) lies within
+    :data:`HAND_REACH` of the body's largest side of one of ``wrists``."""
+    if not wrists:
+        return False
+    points = np.array(list(wrists.values()), dtype=np.float64)
+    distances = np.linalg.norm(candidate.touching[:, None, :] - points[None, :, :], axis=2).min(axis=1)
+    return bool(np.mean(distances <= HAND_REACH * body_size) >= AT_HAND_SHARE)
 
 
 def own_hands(wrists: dict, elbows: dict, body: np.ndarray, body_size: float) -> dict:
-    """The wrists past which ``body`` (world vertices, without any candidate) goes on, a hand of its own:
-    some vertex within :data:`HAND_REACH` of the body's largest side of the wrist lies at least
-    :data:`HAND_PAST` of it beyond the wrist along the forearm (elbow to wrist). A body whose hands are
-    objects of their own ends at the wrists. Returns a dict mapping each such wrist's name to the
+    """The wrists past which ``body`` (world vertices, without the objects at the wrists) goes on, a hand
+    of its own: some vertex within :data:`HAND_RADIUS` of the body's largest side of the forearm's line
+    (elbow through wrist) and within :data:`HAND_REACH` of the wrist lies at least :data:`HAND_PAST` of
+    it beyond the wrist. A body whose hands are objects of their own ends at the wrists; the line keeps a
+    thigh beside a hanging hand from counting. Returns a dict mapping each such wrist's name to the
     forearm's unit direction there."""
     hands = {}
     body = np.asarray(body, dtype=np.float64)
@@ -235,8 +230,10 @@ def own_hands(wrists: dict, elbows: dict, body: np.ndarray, body_size: float) ->
             continue
         pointing = (wrist - elbow) / np.linalg.norm(wrist - elbow)
         offsets = body - wrist
-        near = np.linalg.norm(offsets, axis=1) <= HAND_REACH * body_size
-        if near.any() and (offsets[near] @ pointing).max() >= HAND_PAST * body_size:
+        along = offsets @ pointing
+        across = np.linalg.norm(offsets - along[:, None] * pointing, axis=1)
+        near = (np.linalg.norm(offsets, axis=1) <= HAND_REACH * body_size) & (across <= HAND_RADIUS * body_size)
+        if near.any() and along[near].max() >= HAND_PAST * body_size:
             hands[name] = pointing
     return hands
 
@@ -246,13 +243,14 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
 
     Parameters
     ----------
-    candidates : Candidates (:func:`thin_candidates`, :func:`thick_candidates`)
+    candidates : Candidates (:func:`hand_candidates`)
     wrists : dict mapping ``wrist.L`` and ``wrist.R`` (those found) to (3,) world points
     body_size : float, the largest side of the body without the candidates, scene units
-    hands : dict or None, mapping a thick candidate's object index to :func:`own_hands` of the body
-        without it: the wrists with a hand of the body's own and the forearm's direction there; a thick
-        candidate is held only at one of those, lying past the wrist (in the hand, not around the
-        forearm). None: no thick candidate is held
+    hands : dict or None, :func:`own_hands` of the body without the thick candidates at the wrists: the
+        wrists with a hand of the body's own and the forearm's direction there; a thick candidate is
+        held only at one of those, its surface lying on the whole at least :data:`HELD_PAST` of the body's
+        largest side past the wrist (in the hand, not a cuff around the forearm). None: no thick candidate
+        is held
 
     Returns
     -------
@@ -276,8 +274,9 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
             if np.mean(beyond) < BEYOND_HAND_SHARE:
                 continue
         else:
-            pointing = (hands or {}).get(candidate.object_index, {}).get(names[holding])
-            if pointing is None or (candidate.surface.mean(axis=0) - points[holding]) @ pointing <= 0:
+            pointing = (hands or {}).get(names[holding])
+            past = None if pointing is None else (candidate.surface.mean(axis=0) - points[holding]) @ pointing
+            if past is None or past < HELD_PAST * body_size:
                 continue
         grip = candidate.touching[at_hand & (nearest == holding)].mean(axis=0)
         held.append(Prop(candidate.object_index, grip, candidate.gap, True))
@@ -285,7 +284,7 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
 
 
 class BodyReading(NamedTuple):
-    """The body :func:`held_at_hands_reading` read (the mesh without what is
+    """The body :func:`props_held_at_hands_reading` read (the mesh without what is
     not the character, the props told and the candidates) and the
     prediction's votes on it, which a caller rigging that same body can use
     instead of reading it again."""
@@ -295,37 +294,36 @@ class BodyReading(NamedTuple):
 
 
 def props_held_at_hands(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Prop, ...]:
-    """The thin objects of ``mesh`` held at the hands (:func:`held_at_hands_reading`)."""
-    return held_at_hands_reading(mesh, left_out, told)[0]
+    """The objects of ``mesh`` held at the hands (:func:`props_held_at_hands_reading`)."""
+    return props_held_at_hands_reading(mesh, left_out, told)[0]
 
 
-def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(), *,
-                          candidates: tuple[Candidate, ...] | None = None,
-                          progress: ProgressCallback | None = None) -> tuple[tuple[Prop, ...], BodyReading | None]:
-    """The thin objects of ``mesh`` held at the hands (both steps of the module
+def props_held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(), *,
+                                progress: ProgressCallback | None = None
+                                ) -> tuple[tuple[Prop, ...], BodyReading | None]:
+    """The objects of ``mesh`` held at the hands (both steps of the module
     docstring), and the body read to tell them.
 
     The landmark network reads the body (``mesh`` without ``left_out``, the
-    ``told`` props and the candidates) only when there is a candidate; a
+    ``told`` props and the thin candidates) only when there is a candidate; a
     body it cannot read (too few faces), or does not read as a biped (surely,
-    or by its nearest known body), holds nothing.
+    or by its nearest known body), holds nothing. The body read is the one
+    rigged when no thin candidate is there and nothing is held.
 
     Parameters
     ----------
     mesh : Mesh, world space, one or more objects
     left_out : (n,) bool array or None, vertices that are not the character
     told : indices of objects already told as props
-    candidates : tuple of Candidate or None, :func:`thin_candidates` of the same arguments when the
-        caller found them already (a job deciding whether the reading is worth a task of its own)
-    progress : optional ProgressCallback of the reading (may raise Cancelled)
+    progress : optional ProgressCallback (may raise Cancelled)
 
     Returns
     -------
     props : tuple of Prop, in the objects' order
     reading : BodyReading, or None when no body was read
     """
-    if candidates is None:
-        candidates = hand_candidates(mesh, left_out, told)
+    report(progress, 0.0, "Looking for what the hands may hold")
+    candidates = hand_candidates(mesh, left_out, told)
     if not candidates:
         return (), None
     rows = np.ones(mesh.vertex_count, dtype=bool) if left_out is None else ~np.asarray(left_out, dtype=bool)
@@ -344,10 +342,11 @@ def held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, told=(
     wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
     elbows = {name: apply_transform(points[name], to_mesh)[0] for name in ELBOWS if name in points}
     size = largest_side(body.vertices)
-    hands = {}
+    # Has the body hands of its own? Asked without every thick object at a wrist: a hand that is an object
+    # of its own and what it holds alike.
+    without = rows.copy()
     for candidate in candidates:
-        if not candidate.thin:  # without it, has the body a hand of its own? (it may be the hand)
-            without = rows.copy()
+        if not candidate.thin and at_a_wrist(candidate, wrists, size):
             without[mesh.object_slice(candidate.object_index)] = False
-            hands[candidate.object_index] = own_hands(wrists, elbows, mesh.vertices[without], size)
+    hands = own_hands(wrists, elbows, mesh.vertices[without], size)
     return held_at_hands(candidates, wrists, size, hands), reading

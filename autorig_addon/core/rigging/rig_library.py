@@ -305,8 +305,9 @@ def shipped_library() -> RigLibrary | None:
 @contextmanager
 def shipped_library_without(names):
     """Inside, :func:`shipped_library` lacks the characters ``names`` (paths in the data without
-    extension): scoring a training character (``eval rig``), its own rig and its family's are not
-    there to copy, as for a character the project has never seen."""
+    extension): scoring a training character (``eval rig``), its own rig and its near-duplicates' are
+    not there to copy, as for a character the project has never seen. Each call leaves its names out
+    of the whole shipped library: nested calls do not add up."""
     library = _loaded_library()
     if library is not None:
         library = library.subset(~np.isin(library.names, sorted(names)))
