@@ -3,12 +3,14 @@ meshes (``core.rigging.predict``), and the same bound with skin weights
 (Auto-Rig), for the Predict Skeleton and Auto-Rig operators and the ``rig``
 command.
 
-The work is written as a sequence of steps (:func:`rig_steps`): a generator
-that yields the slow, ``bpy``-free parts (the joint network, the skin
-weights) as tasks and does the Blender parts itself between them. The modal
-operators run each task in a worker thread (:class:`TaskJob`; progress in
-the status bar, Esc cancels); background runs and the ``rig`` command run
-the same steps on the main thread (:func:`run_steps`). A failure or a
+The work is written as a sequence of steps (:func:`plan_rig_steps`, then
+:func:`rig_steps`, chained by :func:`planned_rig_steps`): generators that
+yield the slow, ``bpy``-free parts (telling what the hands hold, the joint
+network, the skin weights) as tasks and do the Blender parts themselves
+between them. The modal operators run each task in a worker thread
+(:class:`TaskJob`; progress in the status bar, Esc cancels); background runs
+and the ``rig`` command run the same steps on the main thread
+(:func:`run_steps`). A failure or a
 cancel anywhere removes the armature and restores every mesh, so nothing
 is ever left half built.
 
