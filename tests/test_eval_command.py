@@ -344,12 +344,19 @@ def test_a_training_character_is_scored_without_its_own_rig_to_copy(clean_scene,
 
 
 def test_a_file_the_split_does_not_name_or_no_split_leaves_nothing_out(tmp_path, monkeypatch):
-    """A file outside the split, or an installed extension without data_split.json: the library stays whole."""
+    """A file outside the split, or an installed extension without data_split.json: the library stays whole;
+    a listed character's file in another format is still found."""
     from autorig_addon.core.rigging import rig_library
 
     whole = list(rig_library.shipped_library().names)
-    with evaluation_methods.itself_left_out(tmp_path / "elsewhere" / "Body.glb"):
-        assert list(rig_library.shipped_library().names) == whole
+    # The split names quaternius_glb/animals_pack/Horse.glb: only a path ending in all of that is it.
+    for path in ("elsewhere/Body.glb", "other/Horse.glb", "animals_pack/Horse.glb",
+                 "xquaternius_glb/animals_pack/Horse.glb"):
+        with evaluation_methods.itself_left_out(tmp_path / path):
+            assert list(rig_library.shipped_library().names) == whole, path
+    # A .blend saved from it is the same character.
+    with evaluation_methods.itself_left_out(tmp_path / "quaternius_glb" / "animals_pack" / "Horse.blend"):
+        assert "quaternius_glb/animals_pack/Horse" not in set(rig_library.shipped_library().names)
     monkeypatch.setattr(evaluation_methods, "_repository_split", lambda: None)
     with evaluation_methods.itself_left_out(tmp_path / "quaternius_glb" / "animals_pack" / "Horse.glb"):
         assert list(rig_library.shipped_library().names) == whole

@@ -17,6 +17,7 @@ from autorig_addon.core.rigging.held_at_hands import (
     held_at_hands,
     own_hands,
     props_held_at_hands,
+    props_held_at_hands_reading,
     thick_candidates,
     thin_candidates,
     thinness,
@@ -151,9 +152,12 @@ def test_a_thick_candidate_is_held_only_in_a_hand_of_the_bodys_own_and_past_the_
     # ... and a cuff around the forearm short of the wrist, touching at the same place.
     cuff = Candidate(2, wrists["wrist.R"] + [0.08, 0.0, 0.0] + rng.uniform(-0.04, 0.04, (200, 3)), at_right,
                      0.0, thin=False)
+    # ... and a bracelet at the wrist, its middle past it by half of HELD_PAST only.
+    bracelet = Candidate(3, wrists["wrist.R"] + [-0.5 * HELD_PAST * size, 0.0, 0.0]
+                         + rng.uniform(-0.04, 0.04, (200, 3)) * [0.0, 1.0, 1.0], at_right, 0.0, thin=False)
     right_hand = {"wrist.R": np.array([-1.0, 0.0, 0.0])}
     assert 0.08 > HELD_PAST * size
-    props = held_at_hands([mug, cuff], wrists, size, right_hand)
+    props = held_at_hands([mug, cuff, bracelet], wrists, size, right_hand)
     assert [prop.object_index for prop in props] == [1]
     np.testing.assert_allclose(props[0].grip, at_right.mean(axis=0))
     # Without a hand of the body's own there (the object may be the hand), or not told: not held.
@@ -198,4 +202,8 @@ def test_hands_that_are_objects_of_their_own_are_not_held(holding):
         objects.append(Mesh(ball.vertices, ball.triangles, object_names=("Ball",)))
     mesh = Mesh.concatenate(objects)
     assert [candidate.object_index for candidate in thick_candidates(mesh)] == ([1, 2, 3] if holding else [1, 2])
-    assert props_held_at_hands(mesh) == ()
+    props, reading = props_held_at_hands_reading(mesh)
+    assert props == ()
+    # Not for want of wrists: the body is read as a biped, its wrists found.
+    assert reading.votes.landmarks.kind == "biped"
+    assert {"wrist.L", "wrist.R"} <= set(reading.votes.landmarks.points_for("biped"))

@@ -5,6 +5,7 @@ the hand; a helmet and a bracer lying on the body are skinned as before.
 Built as a user builds them, with real bpy."""
 
 import json
+import re
 from itertools import combinations
 
 import bpy
@@ -29,6 +30,7 @@ from blender_fixtures import (
     evaluated_world_vertices,
     group_weights,
     local_positions,
+    make_armature,
     mesh_object,
     parent_to_bone,
     pose_bone_turned,
@@ -539,6 +541,39 @@ def test_esc_while_the_hands_are_read_stops_the_run_with_the_scene_as_it_was(cle
     assert any("network" in message for message in reported)
     assert armatures() == []
     assert scene_state([body, sword, offhand]) == before
+
+
+def test_a_held_sword_already_bound_is_refused_before_the_hands_are_read(clean_scene, monkeypatch):
+    """Auto-Rig binds what the hands hold with the body, so a sword already bound to another armature is
+    refused (naming it), and before the slow reading that tells it held: no body is read."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    old = make_armature("Old")
+    modifier = sword.modifiers.new("Armature", "ARMATURE")
+    modifier.object = old
+    select_only([body, sword, offhand], active=body)
+    before = scene_state([body, sword, offhand, old])
+
+    with pytest.raises(RuntimeError, match=re.escape(
+            "'Sword' is already bound to the armature 'Old': turn on Replace Binding")):
+        bpy.ops.autorig.auto_rig()
+    assert readings == []
+    assert scene_state([body, sword, offhand, old]) == before
+
+
+def test_a_character_of_several_objects_holding_nothing_reads_no_body_to_tell_it(clean_scene, monkeypatch):
+    """A body and a ground plane under it: planning's task finds no candidate and reads no body."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+    ground = box_mesh((-1.0, -1.0, -0.01), (1.0, 1.0, 0.0), 0.5)
+    plane = mesh_object("Ground", ground.vertices, ground.triangles)
+    bpy.context.view_layer.update()
+    steps = plan_rig_steps([body, plane], bpy.context.evaluated_depsgraph_get(), "Biped")
+
+    task = next(steps)
+    assert task(None) == ((), None)
+    assert readings == []
 
 
 def test_a_single_mesh_is_planned_without_a_task(clean_scene, monkeypatch):

@@ -214,7 +214,8 @@ def _repository_split():
 @contextmanager
 def itself_left_out(path: Path):
     """Inside, the built-in rig methods copy nothing of the character in the file ``path`` or its
-    near-duplicates (``data_split.json``, which names the file whatever folder ``eval`` was given):
+    near-duplicates (``data_split.json``, which names the file whatever folder ``eval`` was given, in
+    any format: a .blend saved from a listed .glb too):
     not their rigs from the rig library (``core.rigging.rig_library.shipped_library_without``), not
     their skeletons as the closest character. A validation character and its near-duplicates are in
     neither, so its score does not change; a training character is scored without its own artist's
@@ -224,7 +225,7 @@ def itself_left_out(path: Path):
     from ..core.rigging.rig_library import shipped_library_without
 
     split = _repository_split()
-    entry = split_entry(Path(path), split)
+    entry = split_entry(Path(path), split, any_extension=True)
     left_out = split.near_duplicate_names(os.path.splitext(entry)[0]) if entry is not None else frozenset()
     _LEFT_OUT.append(left_out)
     try:

@@ -275,7 +275,8 @@ def plan_rig_steps(meshes: list, depsgraph, name: str, settings: RigSettings = R
     one). The operators run it in the worker like the prediction (progress,
     Esc), not while the operator starts; the rest reads Blender's objects and
     is quick, and its refusals (a mesh already bound, several characters)
-    come before it.
+    come before it; the flat-shape refusal comes after, measuring the
+    character without what its hands hold.
 
     What is not the character (``core.rigging.character_parts``) is told
     apart here: a ground plane and stray specks are left out (a mesh wholly

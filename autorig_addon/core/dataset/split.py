@@ -271,10 +271,16 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
     return items
 
 
-def split_entry(path: Path, split: Optional[DataSplit]) -> Optional[str]:
-    """The split's relative path naming ``path`` (the longest that ends it), if any."""
+def split_entry(path: Path, split: Optional[DataSplit], any_extension: bool = False) -> Optional[str]:
+    """The split's relative path naming ``path`` (the longest that ends it, whole folder names), if any;
+    ``any_extension``: compared without the extensions (a .blend saved from a listed .glb)."""
     if split is None:
         return None
     text = path.resolve().as_posix()
-    matches = [entry for entry in split.subset("all") if text == entry or text.endswith("/" + entry)]
+
+    def bare(name: str) -> str:
+        return os.path.splitext(name)[0] if any_extension else name
+
+    matches = [entry for entry in split.subset("all")
+               if bare(text) == bare(entry) or bare(text).endswith("/" + bare(entry))]
     return max(matches, key=len) if matches else None

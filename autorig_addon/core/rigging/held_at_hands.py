@@ -80,6 +80,8 @@ ELBOWS = ("elbow.L", "elbow.R")
 #: human hand: about 0.05 of the height), within :data:`HAND_RADIUS` of the forearm's line; a thick
 #: candidate is held only in such a hand ...
 HAND_PAST = 0.03
+#: ... counting the body's vertices within this share of the body's largest side of the forearm's line
+#: (elbow through wrist): a hand, not a thigh beside a hanging hand ...
 HAND_RADIUS = 0.04
 #: ... and only when its surface lies on the whole at least this share past the wrist: a mug in the fist
 #: (0.06 on the procedural biped), not a cuff or a bracelet at the wrist.
@@ -155,8 +157,9 @@ def _touching(points: np.ndarray, query: TriangleMeshQuery, near: float) -> tupl
 def hand_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) -> tuple[Candidate, ...]:
     """The objects of ``mesh`` that may be props held at the hands (module docstring, step 1): small,
     sticking out of the rest and touching it; thin ones (a blade, a staff, a shield) measured against the
-    body without every thin object, thick ones (a mug; ``thin`` False) each against the body without it
-    (they stay in the body the landmark network reads).
+    body without every small thin object, thick ones (a mug; ``thin`` False) each against that body
+    without it too (they stay in the body the landmark network reads). A thick object touching only a
+    small thin one is no candidate.
 
     Parameters
     ----------
@@ -245,7 +248,7 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
     ----------
     candidates : Candidates (:func:`hand_candidates`)
     wrists : dict mapping ``wrist.L`` and ``wrist.R`` (those found) to (3,) world points
-    body_size : float, the largest side of the body without the candidates, scene units
+    body_size : float, the largest side of the body without the thin candidates, scene units
     hands : dict or None, :func:`own_hands` of the body without the thick candidates at the wrists: the
         wrists with a hand of the body's own and the forearm's direction there; a thick candidate is
         held only at one of those, its surface lying on the whole at least :data:`HELD_PAST` of the body's
@@ -285,7 +288,7 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
 
 class BodyReading(NamedTuple):
     """The body :func:`props_held_at_hands_reading` read (the mesh without what is
-    not the character, the props told and the candidates) and the
+    not the character, the props told and the thin candidates) and the
     prediction's votes on it, which a caller rigging that same body can use
     instead of reading it again."""
 
@@ -308,7 +311,8 @@ def props_held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, 
     ``told`` props and the thin candidates) only when there is a candidate; a
     body it cannot read (too few faces), or does not read as a biped (surely,
     or by its nearest known body), holds nothing. The body read is the one
-    rigged when no thin candidate is there and nothing is held.
+    rigged when every thin candidate is held and no thick one is (and the
+    caller tells no prop piece joined into a mesh).
 
     Parameters
     ----------
