@@ -408,21 +408,30 @@ def add_mirrored_swords():
     return sword, offhand
 
 
+def auto_rigged_with_mirrored_swords(readings: list | None = None) -> tuple:
+    """Auto-Rig on the biped holding a sword in each hand (objects of their own, no rig), checked to give the
+    bones of the biped alone: (armature, body, sword, offhand). ``readings`` (:func:`counted_readings`) is
+    cleared after the biped alone is read, so it counts Auto-Rig's readings only."""
+    names_alone, _ = bones_of_the_biped_alone()
+    if readings is not None:
+        readings.clear()
+    body = add_biped()
+    sword, offhand = add_mirrored_swords()
+    select_only([body, sword, offhand], active=body)
+    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+    (armature,) = armatures()
+    assert [bone.name for bone in armature.data.bones] == names_alone
+    return armature, body, sword, offhand
+
+
 def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(clean_scene, capfd):
     """A mirrored pair has a twin each, so props.py kept them as body: the
     hands' bones ran along the blades (5 mm from them) and each blade was
     skinned over the hand and the forearm. Thin, sticking out and touching
     the body only where the landmark network puts its wrists, they are now
     held props (core.rigging.held_at_hands)."""
-    names_alone, _ = bones_of_the_biped_alone()
-    body = add_biped()
-    sword, offhand = add_mirrored_swords()
-    select_only([body, sword, offhand], active=body)
+    armature, _, sword, offhand = auto_rigged_with_mirrored_swords()
 
-    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
-
-    (armature,) = armatures()
-    assert [bone.name for bone in armature.data.bones] == names_alone
     out = capfd.readouterr().out
     for obj, bone in ((sword, "hand.R"), (offhand, "hand.L")):
         assert f"'{obj.name}' held: bound wholly to bone '{bone}' (a rigid prop, left out of the skeleton)" in out
@@ -480,16 +489,9 @@ def test_the_body_read_to_tell_the_swords_is_not_read_again(clean_scene, monkeyp
     rigged, so Auto-Rig uses that reading instead of a second prediction pass
     (the skeleton the same as read afresh)."""
     readings = counted_readings(monkeypatch)
-    names_alone, _ = bones_of_the_biped_alone()
-    readings.clear()
-    body = add_biped()
-    sword, offhand = add_mirrored_swords()
-    select_only([body, sword, offhand], active=body)
 
-    assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
+    _, body, _, _ = auto_rigged_with_mirrored_swords(readings)
 
-    (armature,) = armatures()
-    assert [bone.name for bone in armature.data.bones] == names_alone
     assert readings == [len(body.data.vertices)]  # one reading, of the body alone
 
 
