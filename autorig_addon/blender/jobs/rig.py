@@ -494,7 +494,6 @@ def _remember(armature, votes: JointVotes, known_rig: bool = True) -> None:
         _PREDICTIONS.popitem(last=False)
 
 
-
 def rig_steps(context, plan: RigPlan, *, remember: bool = True) -> Generator[Task, object, RigResult]:
     """The steps of a prediction (and, with ``plan.skin``, the binding).
     ``remember``: cache the votes for live re-clustering (the operators; not
