@@ -12,6 +12,7 @@ from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
     FREE_FORM,
+    HIND_FOOT_BEHIND,
     MAX_NECK_LENGTH,
     QUADRUPED,
     SYMMETRIC_PAIR_DISTANCE,
@@ -22,6 +23,7 @@ from autorig_addon.core.rigging.standard_skeleton import (
     Landmarks,
     biped_skeleton,
     head_near_neck,
+    hind_legs_over_their_feet,
     hips_at_most_at_hip_joints,
     landmark_warnings,
     quadruped_skeleton,
@@ -32,6 +34,7 @@ from autorig_addon.core.rigging.standard_skeleton import (
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.skeleton.naming import mirror_name
 from autorig_addon.core.types import Skeleton
+from geometry_fixtures import box_mesh
 
 BIPED_BONES = {
     "spine", "spine.001", "spine.002", "spine.003", "neck", "head",
@@ -310,3 +313,60 @@ def test_a_flat_palm_is_not_taken_for_the_wrist():
     # instead of the outline, the wrist would go 1.6 cm into the palm.
     assert WRIST_SECTION_PERCENTILE == 90
     np.testing.assert_allclose(moved["wrist.L"], [0.45, 0.0, 0.7], atol=5e-3)
+
+
+#: A block animal (normalised: feet at z = 0, facing -y, 1 long): a body from 0.3 to 0.55 high and four legs 6 cm
+#: square down to the ground, the front feet at y = -0.35, the hind feet at y = FOOT.
+FOOT = 0.35
+
+
+def block_animal(hind_foot: float = FOOT, lying: bool = False) -> np.ndarray:
+    """The block animal's surface vertices; ``lying``: its body on the ground instead of legs."""
+    parts = [box_mesh((-0.15, -0.5, 0.0 if lying else 0.3), (0.15, 0.5, 0.55), 0.01)]
+    if not lying:
+        for x in (-0.08, 0.08):
+            for y in (-0.35, hind_foot):
+                parts.append(box_mesh((x - 0.03, y - 0.03, 0.0), (x + 0.03, y + 0.03, 0.3), 0.01))
+    return np.vstack([part.vertices for part in parts])
+
+
+def block_animal_landmarks(hind_forward: float) -> dict:
+    """The block animal's key joints, its hind legs ``hind_forward`` in front of their feet."""
+    points = {"hips": np.array([0.0, 0.3 - hind_forward, 0.45]), "neck": np.array([0.0, -0.4, 0.5]),
+              "head": np.array([0.0, -0.45, 0.5])}
+    for side, x in ((".L", 0.08), (".R", -0.08)):
+        points |= {"shoulder" + side: np.array([x, -0.35, 0.35]), "elbow" + side: np.array([x, -0.35, 0.18]),
+                   "wrist" + side: np.array([x, -0.35, 0.03]),
+                   "hip" + side: np.array([x, FOOT - hind_forward, 0.35]),
+                   "knee" + side: np.array([x, FOOT - hind_forward, 0.18]),
+                   "ankle" + side: np.array([x, FOOT - hind_forward, 0.03])}
+    return points
+
+
+def test_hind_legs_put_in_front_of_their_feet_are_moved_back_onto_them():
+    """Hind legs 0.12 in front of where their feet stand are moved back along the body onto them (hip, knee
+    and ankle by the same), the hips with them; the front legs stay."""
+    points = block_animal_landmarks(0.12)
+    moved = hind_legs_over_their_feet(points, block_animal())
+    for side in (".L", ".R"):
+        for role in ("hip", "knee", "ankle"):
+            np.testing.assert_allclose(moved[role + side], points[role + side] + [0.0, 0.12, 0.0], atol=0.005)
+        for role in ("shoulder", "elbow", "wrist"):
+            np.testing.assert_array_equal(moved[role + side], points[role + side])
+    np.testing.assert_allclose(moved["hips"], points["hips"] + [0.0, 0.12, 0.0], atol=0.005)
+    np.testing.assert_array_equal(moved["neck"], points["neck"])
+
+
+@pytest.mark.parametrize("hind_forward", [0.0, HIND_FOOT_BEHIND - 0.01, -0.08])
+def test_hind_legs_over_or_behind_their_feet_or_near_them_stay(hind_forward):
+    """Over their feet, in front by less than HIND_FOOT_BEHIND, or behind them (toes and hooves reach forward
+    of the artists' ankles): nothing moves."""
+    points = block_animal_landmarks(hind_forward)
+    moved = hind_legs_over_their_feet(points, block_animal())
+    assert all(np.array_equal(moved[name], points[name]) for name in points)
+
+
+def test_an_animal_lying_on_the_ground_has_no_feet_to_move_its_legs_onto():
+    points = block_animal_landmarks(0.12)
+    moved = hind_legs_over_their_feet(points, block_animal(lying=True))
+    assert all(np.array_equal(moved[name], points[name]) for name in points)
