@@ -4,7 +4,8 @@ Usage: .venv/bin/python scripts/check_skeleton_quality.py [SAMPLE_DIR]
 
 Each sample's deform skeleton (joints closer than the evaluation's merge
 tolerance merged, as ``eval rig`` scores them), all checks but the one-tree check, is checked against its
-mesh's voxel solid; prints each flagged character with its problems, then
+mesh's voxel solid and, for a point the solid leaves out, the winding number of its surface (as Auto-Rig
+checks); prints each flagged character with its problems, then
 how many of how many were flagged. A check that flags many artists' rigs
 would refuse sound predictions.
 """
@@ -17,7 +18,7 @@ from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.evaluation.skeleton_metrics import COINCIDENT_JOINT_FRACTION, merge_coincident_joints
 from autorig_addon.core.rigging.joint_features import solid_depth
-from autorig_addon.core.rigging.quality import skeleton_problems
+from autorig_addon.core.rigging.quality import enclosed_by, skeleton_problems
 
 
 def main(folder: str) -> int:
@@ -30,7 +31,8 @@ def main(folder: str) -> int:
         skeleton = merge_coincident_joints(sample.skeleton.deform_subset(), COINCIDENT_JOINT_FRACTION)
         # An artist's deform bones alone are often several trees once the helpers between them go: that check
         # is for predictions, which are one tree by construction.
-        problems = [problem for problem in skeleton_problems(skeleton, solid_depth(sample.mesh).at, sample.vertices)
+        problems = [problem for problem in skeleton_problems(skeleton, solid_depth(sample.mesh).at, sample.vertices,
+                                                             enclosed_by(sample.mesh))
                     if "separate trees" not in problem]
         total += 1
         if problems:

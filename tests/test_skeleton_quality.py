@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from autorig_addon.core.rigging.quality import FAR_FROM_SURFACE, skeleton_problems
-from autorig_addon.core.types import Skeleton
+from autorig_addon.core.rigging.quality import FAR_FROM_SURFACE, enclosed_by, skeleton_problems
+from autorig_addon.core.types import Mesh, Skeleton
+from geometry_fixtures import box_mesh
 
 #: A body: the box |x| <= 0.2, |y| <= 0.1, 0 <= z <= 1, its surface sampled on a grid.
 LOW, HIGH = np.array([-0.2, -0.1, 0.0]), np.array([0.2, 0.1, 1.0])
@@ -57,3 +58,22 @@ def test_two_trees_a_long_bone_and_misplaced_limbs_are_named():
         "the arms do not hang from the spine above the hips",)
     head_down = biped(**{"head": ([0, 0, 0.3], "neck")})
     assert "the head is not above the hips" in skeleton_problems(head_down, depth, SURFACE)
+
+
+def test_bones_inside_an_open_mesh_whose_solid_is_a_shell_are_inside_the_body():
+    """A 0 A.D. animal's mesh has holes, so its voxel solid leaked to its shell: no depth anywhere inside. A
+    bone along the middle of such a body (a box 0.8 across without its top, the bone 0.4 from every wall,
+    farther than FAR_FROM_SURFACE) read with the solid alone lies outside; its surface still encloses it
+    (winding number 5/6 at the centre), so with ``enclosed`` it is inside. A bone leaving the box stays outside."""
+    box = box_mesh((-0.4, -0.4, 0.0), (0.4, 0.4, 1.0), 0.1)
+    open_top = box.triangles[~(box.vertices[box.triangles][:, :, 2] > 0.999).all(axis=1)]
+    surface = Mesh(box.vertices, open_top)
+    spine = Skeleton(np.array([[0.0, 0, 0.2], [0.0, 0, 0.5], [0.0, 0, 0.8]]), np.array([-1, 0, 1]),
+                     ("spine", "spine.001", "spine.002"))
+    shell = lambda points: np.zeros(len(points))  # noqa: E731
+    assert 0.4 > FAR_FROM_SURFACE
+    assert skeleton_problems(spine, shell, box.vertices) == ("spine, spine.001 lie mostly outside the body",)
+    assert skeleton_problems(spine, shell, box.vertices, enclosed_by(surface)) == ()
+    leaving = Skeleton(np.array([[0.3, 0, 0.5], [1.25, 0, 0.5]]), np.array([-1, 0]), ("root", "tip"))
+    assert skeleton_problems(leaving, shell, box.vertices, enclosed_by(surface)) == (
+        "root lies mostly outside the body",)

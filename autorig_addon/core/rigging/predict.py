@@ -47,7 +47,7 @@ from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph,
 from .mean_shift import mean_shift_modes
 from .networks import joints as joint_network
 from .orientation import STANDING_MIDLINE, axis_name, feet_across, stand_upright
-from .quality import skeleton_problems
+from .quality import enclosed_by, skeleton_problems
 from .rig_library import KNOWN_RIG, KnownRelative, KnownRig, closest_rig, fitted_rig, nearest_known_body
 from .role_names import role_names
 from .standard_skeleton import (
@@ -389,7 +389,8 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
         return ()
     normalised = Skeleton(apply_transform(skeleton.joints, votes.transform), skeleton.parents, skeleton.names,
                           apply_transform(skeleton.tails, votes.transform))
-    return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices)
+    enclosed = enclosed_by(votes.surface) if votes.surface is not None else None
+    return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices, enclosed)
 
 
 class CheckedSkeleton(NamedTuple):

@@ -7,9 +7,10 @@ reject at first sight:
 * more than one tree (a part that would not follow the rest);
 * a bone longer than the body;
 * bones lying mostly outside the body (more than :data:`MAX_OUTSIDE_SHARE`
-  of the points from a joint to a child joint where the solid has no depth
-  and the surface is farther than :data:`FAR_FROM_SURFACE`; a leaf's tail,
-  only an estimate, is not checked);
+  of the points from a joint to a child joint where the solid has no depth,
+  the surface is farther than :data:`FAR_FROM_SURFACE` and, when the caller
+  can tell, the surface does not enclose them: an open mesh's solid is only
+  its shell; a leaf's tail, only an estimate, is not checked);
 * for a body named as a biped or quadruped (Rigify's role names, or an
   engine preset's): the legs' chains not meeting at the hips, the arms' (or
   front legs') not meeting on the spine above the hips, the head not above
@@ -25,9 +26,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..geometry.winding import winding_numbers
 from ..skeleton.hierarchy import ancestors
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names
-from ..types import Skeleton
+from ..types import Mesh, Skeleton
 
 #: A bone lies mostly outside the body when more than this share of the
 #: points along it are outside the solid.
@@ -56,7 +58,7 @@ def _meeting_joint(parents: np.ndarray, first: int, second: int):
     return next((joint for joint in above_first if joint in above_second), None)
 
 
-def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray) -> tuple:
+def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray, enclosed=None) -> tuple:
     """What is wrong with ``skeleton`` (normalised frame), as sentences; empty when nothing is.
 
     Parameters
@@ -68,6 +70,10 @@ def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray) -> tupl
         vertices): a point outside the solid counts as outside the body only
         when it is also farther than :data:`FAR_FROM_SURFACE` from them, since
         an open shell (a dress, a cape, a helmet) has a solid one cell deep
+    enclosed : callable or None, ``(k, 3) points -> (k,) bool``: whether the
+        character's surface encloses each point (``enclosed_by``): a point it
+        encloses is inside the body whatever the solid says (an open mesh,
+        whose solid leaked to its shell). None: the solid alone tells
     """
     problems = []
     parents = np.asarray(skeleton.parents)
@@ -85,6 +91,8 @@ def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray) -> tupl
     along = starts[:, None, :] + steps[None, :, None] * (ends - starts)[:, None, :]
     points = along.reshape(-1, 3)
     away = (np.asarray(depth_at(points)) <= 0.0) & (cKDTree(surface).query(points)[0] > FAR_FROM_SURFACE)
+    if enclosed is not None and away.any():
+        away[away] = ~np.asarray(enclosed(points[away]), dtype=bool)
     outside = away.reshape(len(starts), BONE_SAMPLES).mean(axis=1)
     stray = list(dict.fromkeys(skeleton.names[parent] for parent, share in zip(children, outside)
                                if share > MAX_OUTSIDE_SHARE))
@@ -92,6 +100,19 @@ def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray) -> tupl
         problems.append(f"{_listed(stray)} {'lies' if len(stray) == 1 else 'lie'} mostly outside the body")
     problems += _body_problems(skeleton)
     return tuple(problems)
+
+
+#: A point is enclosed by a surface whose winding number there is at least this (1 inside a closed surface,
+#: 0 outside; an open box's centre 0.83).
+ENCLOSED_WINDING = 0.5
+
+
+def enclosed_by(surface: Mesh):
+    """``(k, 3) points -> (k,) bool``: whether ``surface`` (outward wound) encloses each point, by its
+    generalised winding number (``core.geometry.winding``), which an open mesh's holes do not fool."""
+    def enclosed(points: np.ndarray) -> np.ndarray:
+        return winding_numbers(points, surface.vertices, surface.triangles) >= ENCLOSED_WINDING
+    return enclosed
 
 
 def _body_problems(skeleton: Skeleton) -> list:
