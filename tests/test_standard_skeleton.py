@@ -320,13 +320,15 @@ def test_a_flat_palm_is_not_taken_for_the_wrist():
 FOOT = 0.35
 
 
-def block_animal(hind_foot: float = FOOT, lying: bool = False) -> np.ndarray:
-    """The block animal's surface vertices; ``lying``: its body on the ground instead of legs."""
+def block_animal(hind_foot: float = FOOT, lying: bool = False, right_hind_lifted: bool = False) -> np.ndarray:
+    """The block animal's surface vertices; ``lying``: its body on the ground instead of legs;
+    ``right_hind_lifted``: that foot 5 cm off the ground."""
     parts = [box_mesh((-0.15, -0.5, 0.0 if lying else 0.3), (0.15, 0.5, 0.55), 0.01)]
     if not lying:
         for x in (-0.08, 0.08):
             for y in (-0.35, hind_foot):
-                parts.append(box_mesh((x - 0.03, y - 0.03, 0.0), (x + 0.03, y + 0.03, 0.3), 0.01))
+                bottom = 0.05 if right_hind_lifted and x < 0 and y == hind_foot else 0.0
+                parts.append(box_mesh((x - 0.03, y - 0.03, bottom), (x + 0.03, y + 0.03, 0.3), 0.01))
     return np.vstack([part.vertices for part in parts])
 
 
@@ -369,4 +371,27 @@ def test_hind_legs_over_or_behind_their_feet_or_near_them_stay(hind_forward):
 def test_an_animal_lying_on_the_ground_has_no_feet_to_move_its_legs_onto():
     points = block_animal_landmarks(0.12)
     moved = hind_legs_over_their_feet(points, block_animal(lying=True))
+    assert all(np.array_equal(moved[name], points[name]) for name in points)
+
+
+def test_one_hind_leg_moved_moves_the_hips_half_as_far():
+    """The right hind foot lifted off the ground tells nothing: only the left leg moves, and the hips by the
+    mean of both sides' moves (half), where symmetrising leaves the hip joints."""
+    points = block_animal_landmarks(0.12)
+    moved = hind_legs_over_their_feet(points, block_animal(right_hind_lifted=True))
+    np.testing.assert_allclose(moved["ankle.L"], points["ankle.L"] + [0.0, 0.12, 0.0], atol=0.005)
+    np.testing.assert_array_equal(moved["ankle.R"], points["ankle.R"])
+    np.testing.assert_allclose(moved["hips"], points["hips"] + [0.0, 0.06, 0.0], atol=0.005)
+
+
+def test_an_animal_kept_facing_plus_y_has_its_hind_legs_moved_toward_its_tail():
+    """A body whose front its shape did not tell is kept as given, perhaps facing +y: behind is then -y."""
+    flip = np.array([1.0, -1.0, 1.0])
+    points = {name: point * flip for name, point in block_animal_landmarks(0.12).items()}
+    moved = hind_legs_over_their_feet(points, block_animal() * flip)
+    for side in (".L", ".R"):
+        np.testing.assert_allclose(moved["ankle" + side], points["ankle" + side] - [0.0, 0.12, 0.0], atol=0.005)
+    # Its toes 0.04 toward its head, as hooves reach: nothing moves, whichever way it faces.
+    points = {name: point * flip for name, point in block_animal_landmarks(-0.04).items()}
+    moved = hind_legs_over_their_feet(points, block_animal() * flip)
     assert all(np.array_equal(moved[name], points[name]) for name in points)

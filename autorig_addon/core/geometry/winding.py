@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Point-triangle pairs measured at once (memory: about 100 bytes each).
+#: Point-triangle pairs measured at once (memory: about 200 bytes each, so some 100 MB at once).
 PAIRS_PER_CHUNK = 500_000
 
 

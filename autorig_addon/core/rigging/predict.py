@@ -134,6 +134,7 @@ class JointVotes:
     landmarks : Landmarks of the standard skeleton (:mod:`.standard_skeleton`),
         with the kind of body; None when only the free-form skeleton was asked for
     proxy_vertices : (n, 3) float64, the normalised proxy's vertices (None with ``landmarks``)
+    proxy_triangles : (m, 3) int, the proxy's triangles, outward wound (None with ``proxy_vertices``)
     surface : Mesh, the full-resolution surface in the normalised frame, where
         a standard biped's fingers are looked for (None: no fingers)
     known_rig : KnownRig, the rig of a known body near this one, fitted to it
@@ -148,6 +149,7 @@ class JointVotes:
     notes: tuple = ()
     landmarks: Landmarks | None = None
     proxy_vertices: np.ndarray | None = None
+    proxy_triangles: np.ndarray | None = None
     surface: Mesh | None = None
     known_rig: KnownRig | None = None
 
@@ -276,7 +278,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         notes.append("The shape is not left-right symmetric, so the skeleton is not mirrored.")
     report(progress, 1.0, "Joint votes done")
     return replace(votes, notes=tuple(notes), landmarks=landmarks, proxy_vertices=graph.vertices,
-                   surface=normalised_surface, known_rig=known)
+                   proxy_triangles=proxy.triangles, surface=normalised_surface, known_rig=known)
 
 
 def _turned_note(reason: str) -> str:
@@ -389,7 +391,9 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
         return ()
     normalised = Skeleton(apply_transform(skeleton.joints, votes.transform), skeleton.parents, skeleton.names,
                           apply_transform(skeleton.tails, votes.transform))
-    enclosed = enclosed_by(votes.surface) if votes.surface is not None else None
+    # The proxy (2,000 vertices, the solid's own mesh) keeps the winding numbers' cost small on any mesh.
+    enclosed = (enclosed_by(Mesh(votes.proxy_vertices, votes.proxy_triangles))
+                if votes.proxy_triangles is not None else None)
     return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices, enclosed)
 
 

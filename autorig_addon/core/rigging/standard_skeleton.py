@@ -337,25 +337,30 @@ HIND_FOOT_SPREAD = 0.1
 def hind_legs_over_their_feet(points: dict, vertices: np.ndarray) -> dict:
     """A quadruped's landmarks with each hind leg (its hip, knee and ankle joints) moved back along the body
     onto where its foot stands when the network put that leg in front of its foot (:data:`HIND_FOOT_BEHIND`),
-    and the hips back by the legs' mean move, so the legs still hang from them. ``vertices``: the
-    normalised proxy's (feet at z = 0, facing -y). The 0 A.D. pig and piglet, whose hind legs the network
-    put 0.07 to 0.24 in front of their feet, are what it was written for."""
+    and the hips back by the legs' mean move, so the legs still hang from them. Behind is toward the tail:
+    the way from the front foot to the hind one along y. ``vertices``: the normalised proxy's (feet at
+    z = 0). The 0 A.D. pig and piglet, whose hind legs the network put 0.07 to 0.24 in front of their
+    feet, are what it was written for."""
     points = dict(points)
     ground = vertices[vertices[:, 2] < HIND_FOOT_GROUND_BAND * vertices[:, 2].max()]
     moves = []
     for side, sign in ((LEFT, 1.0), (RIGHT, -1.0)):
         ankle, wrist = points["ankle" + side], points["wrist" + side]
+        # Behind is toward the tail, the way from the front foot to the hind one (a body kept facing +y as
+        # given, whose front the shape did not tell, has its tail at -y).
+        tailward = np.sign(ankle[1] - wrist[1])
         own = ground[sign * ground[:, 0] > 0]
         foot = own[np.abs(own[:, 1] - ankle[1]) < np.abs(own[:, 1] - wrist[1]), 1]
-        if not len(foot) or np.percentile(foot, 90) - np.percentile(foot, 10) > HIND_FOOT_SPREAD:
+        if not tailward or not len(foot) or np.percentile(foot, 90) - np.percentile(foot, 10) > HIND_FOOT_SPREAD:
             continue
-        behind = float(np.median(foot)) - ankle[1]
-        if behind > HIND_FOOT_BEHIND:
+        move = float(np.median(foot)) - ankle[1]
+        if tailward * move > HIND_FOOT_BEHIND:
             for role in ("hip", "knee", "ankle"):
-                points[role + side] = points[role + side] + np.array([0.0, behind, 0.0])
-            moves.append(behind)
+                points[role + side] = points[role + side] + np.array([0.0, move, 0.0])
+            moves.append(move)
     if moves:
-        points["hips"] = points["hips"] + np.array([0.0, float(np.mean(moves)), 0.0])
+        # The mean of both sides' moves (a side not moved counts as 0): where symmetrising leaves the hip joints.
+        points["hips"] = points["hips"] + np.array([0.0, sum(moves) / 2.0, 0.0])
     return points
 
 
