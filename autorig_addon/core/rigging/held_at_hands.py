@@ -208,14 +208,21 @@ def thick_candidates(mesh: Mesh, left_out: np.ndarray | None = None, told=()) ->
     return tuple(candidate for candidate in hand_candidates(mesh, left_out, told) if not candidate.thin)
 
 
+def _nearest_wrists(candidate: Candidate, points: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each point where ``candidate`` touches the body: the index of its nearest wrist of ``points``
+    ((w, 3)) and whether it lies within ``reach`` of it."""
+    distances = np.linalg.norm(candidate.touching[:, None, :] - points[None, :, :], axis=2)
+    nearest = distances.argmin(axis=1)
+    return nearest, distances[np.arange(len(nearest)), nearest] <= reach
+
+
 def at_a_wrist(candidate: Candidate, wrists: dict, body_size: float) -> bool:
     """Whether most of where ``candidate`` touches the body (:data:`AT_HAND_SHARE`) lies within
     :data:`HAND_REACH` of the body's largest side of one of ``wrists``."""
     if not wrists:
         return False
     points = np.array(list(wrists.values()), dtype=np.float64)
-    distances = np.linalg.norm(candidate.touching[:, None, :] - points[None, :, :], axis=2).min(axis=1)
-    return bool(np.mean(distances <= HAND_REACH * body_size) >= AT_HAND_SHARE)
+    return bool(np.mean(_nearest_wrists(candidate, points, HAND_REACH * body_size)[1]) >= AT_HAND_SHARE)
 
 
 def own_hands(wrists: dict, elbows: dict, body: np.ndarray, body_size: float) -> dict:
@@ -266,9 +273,7 @@ def held_at_hands(candidates, wrists: dict, body_size: float, hands: dict | None
     reach = HAND_REACH * body_size
     held = []
     for candidate in candidates:
-        distances = np.linalg.norm(candidate.touching[:, None, :] - points[None, :, :], axis=2)
-        nearest = distances.argmin(axis=1)
-        at_hand = distances[np.arange(len(nearest)), nearest] <= reach
+        nearest, at_hand = _nearest_wrists(candidate, points, reach)
         if np.mean(at_hand) < AT_HAND_SHARE:
             continue
         holding = np.bincount(nearest[at_hand], minlength=len(names)).argmax()
