@@ -1,8 +1,9 @@
 """Short legs and big heads read again (core/rigging/typical_proportions.py): the
-crotch and the neck's pinch found in the solid, the map to typical
-proportions and back, a short-legged biped whose hip joints and a
-big-headed one whose neck the landmark network puts far too high at
-first."""
+crotch and the neck's pinch found in the solid (an open trunk's crotch by
+its surface's winding number), the map to typical proportions and back, a
+short-legged biped whose hip joints and a big-headed one whose neck the
+landmark network puts far too high at first, and hip joints read below the
+crotch raised to it."""
 
 import numpy as np
 import pytest
@@ -13,8 +14,15 @@ from autorig_addon.core.rigging import typical_proportions as proportions
 from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes
+from autorig_addon.core.rigging.quality import enclosed_by
 from autorig_addon.core.rigging.standard_skeleton import Landmarks
-from autorig_addon.core.rigging.typical_proportions import HeightMap, crotch_height, neck_pinch, typical_proportions
+from autorig_addon.core.rigging.typical_proportions import (
+    HeightMap,
+    crotch_height,
+    hip_joints_not_below_crotch,
+    neck_pinch,
+    typical_proportions,
+)
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh
@@ -236,3 +244,66 @@ def test_a_body_read_from_behind_is_read_again_from_behind(monkeypatch, block_fi
         # The right wrist stays at the body's right (-x) either way; in front (-y) as given, behind turned back.
         assert again.points["wrist.R"][0] < 0.0
         assert np.sign(again.points["wrist.R"][1]) == np.sign(again.points["wrist.L"][1]) == wrists_side
+
+
+def open_bottomed_block_body() -> Mesh:
+    """The block body whose trunk has no bottom face (a low-poly body whose
+    legs are objects of their own leaves that hole): its solid leaks to a
+    shell."""
+    legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, CROTCH], 0.05) for side in (-1, 1)]
+    trunk = box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, 1.0], 0.05)
+    bottom = np.all(np.isclose(trunk.vertices[trunk.triangles][:, :, 2], CROTCH), axis=1)
+    return joined(*legs, Mesh(trunk.vertices, trunk.triangles[~bottom]))
+
+
+def test_an_open_trunk_s_crotch_is_where_its_surface_encloses_the_line():
+    mesh = open_bottomed_block_body()
+    solid = solid_depth(mesh)
+    knees = np.array([[0.1, 0.0, 0.15], [-0.1, 0.0, 0.15]])
+    # The solid alone is a shell: the line between the knees goes up the hollow trunk and meets nothing.
+    assert crotch_height(solid, knees, top=1.0) is None
+    # Enclosed by the surface (winding number 0.5 at the hole, rising above it): just above the trunk's bottom.
+    crotch = crotch_height(solid, knees, top=1.0, enclosed=enclosed_by(mesh))
+    assert CROTCH <= crotch <= CROTCH + 0.02, crotch
+    # A closed body's crotch stays the solid's.
+    closed = joined(*[box_mesh([s * 0.1 - 0.05, -0.05, 0.0], [s * 0.1 + 0.05, 0.05, CROTCH], 0.05) for s in (-1, 1)],
+                    box_mesh([-0.2, -0.08, CROTCH], [0.2, 0.08, 1.0], 0.05))
+    closed_solid = solid_depth(closed)
+    assert (crotch_height(closed_solid, knees, 1.0, enclosed_by(closed))
+            == crotch_height(closed_solid, knees, 1.0))
+
+
+def test_hip_joints_read_below_the_crotch_are_raised_to_it_with_the_hips(block_body):
+    points = {"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
+              "hip.L": np.array([0.1, 0.01, 0.22]), "hip.R": np.array([-0.1, 0.01, 0.24]),
+              "hips": np.array([0.0, 0.02, 0.2]), "neck": np.array([0.0, 0.0, 0.9])}
+    raised, lift = hip_joints_not_below_crotch(points, block_body, top=1.0)
+    crotch = crotch_height(block_body, np.array([points["knee.L"], points["knee.R"]]), 1.0)
+    # The middle of the hip joints (0.23) goes to the crotch (about 0.3); each keeps its offset, the hips too.
+    assert lift == pytest.approx(crotch - 0.23)
+    assert 0.06 < lift < 0.08
+    for name in ("hip.L", "hip.R", "hips"):
+        np.testing.assert_allclose(raised[name], points[name] + [0.0, 0.0, lift])
+    for name in ("knee.L", "knee.R", "neck"):
+        np.testing.assert_array_equal(raised[name], points[name])
+    # Hip joints at or above the crotch stay, and so does everything else.
+    above = {**points, "hip.L": np.array([0.1, 0.0, 0.33]), "hip.R": np.array([-0.1, 0.0, 0.33])}
+    kept, lift = hip_joints_not_below_crotch(above, block_body, top=1.0)
+    assert lift == 0.0 and kept is above
+    # Knees above the trunk's top find no crotch: nothing moves.
+    high_knees = {**points, "knee.L": np.array([0.1, 0.0, 0.85]), "knee.R": np.array([-0.1, 0.0, 0.85])}
+    assert hip_joints_not_below_crotch(high_knees, block_body, top=1.0)[1] == 0.0
+
+
+def test_a_biped_s_landmarks_get_their_hip_joints_raised_in_the_prediction(block_body):
+    """The step the prediction runs: a sure biped's landmarks raised on its open body, a quadruped's as they are."""
+    mesh = open_bottomed_block_body()
+    first = {name: np.zeros(3) for name in LANDMARKS}
+    first.update({"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
+                  "hip.L": np.array([0.1, 0.0, 0.2]), "hip.R": np.array([-0.1, 0.0, 0.2]),
+                  "hips": np.array([0.0, 0.0, 0.19])})
+    raised = predict._hip_joints_raised_to_crotch(mesh, solid_depth(mesh), Landmarks(first, SURE_BIPED))
+    assert CROTCH <= raised.points["hip.L"][2] <= CROTCH + 0.02
+    assert raised.points["hips"][2] == pytest.approx(raised.points["hip.L"][2] - 0.01)
+    quadruped = Landmarks(first, {"biped": 0.0, "quadruped": 0.95, "other": 0.05})
+    assert predict._hip_joints_raised_to_crotch(mesh, solid_depth(mesh), quadruped) is quadruped

@@ -64,7 +64,14 @@ from .standard_skeleton import (
 )
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
-from .typical_proportions import TYPICAL_CROTCH_SHARE, TYPICAL_NECK_SHARE, points_back, stretched, typical_proportions
+from .typical_proportions import (
+    TYPICAL_CROTCH_SHARE,
+    TYPICAL_NECK_SHARE,
+    hip_joints_not_below_crotch,
+    points_back,
+    stretched,
+    typical_proportions,
+)
 
 #: Kinds a body's nearest known body (:func:`.rig_library.nearest_known_body`)
 #: may give it when the landmark network reads none surely: bipeds only (a
@@ -268,6 +275,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
+    landmarks = _hip_joints_raised_to_crotch(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     near = landmarks.closest_rig or nearest
@@ -307,7 +315,8 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
     if sure_standard_kind(landmarks) != BIPED:
         return landmarks, ()
     top = float(normalised.vertices[:, 2].max())
-    found = typical_proportions(landmarks.points, solid, top)
+    enclosed = enclosed_by(normalised)
+    found = typical_proportions(landmarks.points, solid, top, enclosed)
     if found is None:
         return landmarks, ()
     body, stretch = stretched(normalised, found.height_map)
@@ -325,6 +334,19 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
                 f"longer: the landmarks were read again on the body stretched to a crotch at "
                 f"{TYPICAL_CROTCH_SHARE:.0%}.")
     return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
+
+
+def _hip_joints_raised_to_crotch(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> Landmarks:
+    """A biped's landmarks with the hip joints (and the hips) no lower than
+    the crotch of its body (``normalised``, ``solid``: as
+    :func:`_read_again_at_typical_proportions` takes them;
+    :func:`.typical_proportions.hip_joints_not_below_crotch`); other
+    landmarks as they are."""
+    if sure_standard_kind(landmarks) != BIPED:
+        return landmarks
+    top = float(normalised.vertices[:, 2].max())
+    points, lift = hip_joints_not_below_crotch(landmarks.points, solid, top, enclosed_by(normalised))
+    return replace(landmarks, points=points) if lift > 0.0 else landmarks
 
 
 def sure_standard_kind(landmarks: Landmarks) -> str | None:
