@@ -6,6 +6,7 @@ from autorig_addon.core.dataset.sample import CharacterSample
 from autorig_addon.core.distances.grid import VoxelGrid
 from autorig_addon.core.geometry.subdivision import subdivide_midpoints
 from autorig_addon.core.procedural import generate_character
+from autorig_addon.core.skeleton.posing import axis_angle_matrices, pose_matrices, posed_vertices
 from autorig_addon.core.types import Mesh, Skeleton, Weights
 
 
@@ -255,3 +256,21 @@ def procedural_biped_with(*objects) -> Mesh:
     body = Mesh(character.mesh.vertices, character.mesh.triangles, object_names=("Biped",))
     return Mesh.concatenate([body, *(Mesh(mesh.vertices, mesh.triangles, object_names=(name,))
                                      for name, mesh in objects)])
+
+
+def procedural_biped_posed(turns: dict) -> tuple[Mesh, dict]:
+    """The procedural biped of seed 0 posed by its own weights: ``turns`` maps
+    deform bone names to (axis, degrees) turns about their heads. Returns the
+    posed mesh (object ``Biped``) and the posed heads of every deform bone by name."""
+    character = generate_character(0, "biped")
+    deform = character.skeleton.deform_subset()
+    rotations = np.tile(np.eye(3), (deform.bone_count, 1, 1))
+    for bone, (axis, degrees) in turns.items():
+        rotations[deform.names.index(bone)] = axis_angle_matrices(np.array([axis], dtype=float),
+                                                                  np.radians([degrees]))[0]
+    weights = character.weights.select_bones(deform.names).matrix
+    posed = posed_vertices(character.mesh.vertices, weights, character.skeleton, rotations[None])[0]
+    matrices = pose_matrices(character.skeleton, rotations)
+    heads = np.einsum("bij,bj->bi", matrices[:, :3, :3], deform.joints) + matrices[:, :3, 3]
+    return (Mesh(posed, character.mesh.triangles, object_names=("Biped",)),
+            dict(zip(deform.names, heads)))

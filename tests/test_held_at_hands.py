@@ -24,7 +24,7 @@ from autorig_addon.core.rigging.held_at_hands import (
 )
 from autorig_addon.core.rigging.nearest_character import surface_points
 from autorig_addon.core.types import Mesh
-from geometry_fixtures import box_mesh, procedural_biped_with
+from geometry_fixtures import box_mesh, procedural_biped_posed, procedural_biped_with
 
 
 def mirror_image(mesh: Mesh) -> Mesh:
@@ -207,3 +207,17 @@ def test_hands_that_are_objects_of_their_own_are_not_held(holding):
     # Not for want of wrists: the body is read as a biped, its wrists found.
     assert reading.votes.landmarks.kind == "biped"
     assert {"wrist.L", "wrist.R"} <= set(reading.votes.landmarks.points_for("biped"))
+
+
+def test_a_sword_in_a_hand_raised_60_degrees_is_held_there():
+    """The procedural biped with its right arm raised 60 degrees (a posed character, not left-right
+    symmetric there) and a sword through that hand: held, gripped at the raised hand. The wrists are the
+    standard skeleton's, read from the mesh: the network's own right wrist lay 0.09 short of the hand,
+    past a hand's reach of where the blade touches it (measured)."""
+    body, heads = procedural_biped_posed({"upper_arm.R": ((0.0, 1.0, 0.0), 60.0)})
+    hand = heads["hand.R"] + 0.5 * (heads["hand.R"] - heads["forearm.R"]) / 2.0  # the palm, past the wrist
+    sword = box_mesh(hand + [-0.008, -0.5, -0.008], hand + [0.008, 0.03, 0.008], 0.02)
+    mesh = Mesh.concatenate([body, Mesh(sword.vertices, sword.triangles, object_names=("Sword",))])
+    (prop,) = props_held_at_hands(mesh)
+    assert prop.object_index == 1 and prop.held
+    np.testing.assert_allclose(prop.grip, hand, atol=0.03)

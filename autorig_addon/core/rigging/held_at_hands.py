@@ -48,16 +48,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..dataset.normalise import apply_transform
 from ..errors import InputError
 from ..geometry.bounding_box import largest_side
 from ..geometry.closest_point import TriangleMeshQuery
 from ..geometry.normals import triangle_double_areas
 from ..progress import ProgressCallback, report
+from ..skeleton.key_joints import key_joints
 from ..types import Mesh
 from .nearest_character import surface_points
 from .networks.landmarks import BODY_KINDS
-from .predict import JointVotes, predict_votes, sure_standard_kind
+from .predict import JointVotes, predict_votes, skeleton_from_votes, sure_standard_kind
 from .props import NEAR_SHARE, OUT_SHARE, PROP_AREA_SHARE, SAMPLES_PER_OBJECT, Prop
 
 #: Thin: the smallest of an object's extents along its principal axes is
@@ -73,7 +73,7 @@ AT_HAND_SHARE = 0.5
 #: from that wrist: a blade, a staff or a shield reaches out of the hand; a
 #: hand, a glove or a short claw does not (they stay the body's).
 BEYOND_HAND_SHARE = 0.5
-#: The wrists and elbows the landmark network reads, left and right (core.skeleton.key_joints).
+#: The wrists and elbows of the body's standard biped skeleton, left and right (core.skeleton.key_joints).
 WRISTS = ("wrist.L", "wrist.R")
 ELBOWS = ("elbow.L", "elbow.R")
 #: A hand of the body's own goes on at least this share of the body's largest side past its wrist (a
@@ -346,10 +346,12 @@ def props_held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, 
     reading = BodyReading(body, votes)
     if sure_standard_kind(votes.landmarks) != HOLDING_KIND:
         return (), reading
-    points = votes.landmarks.points_for(HOLDING_KIND)
-    to_mesh = np.linalg.inv(votes.transform)
-    wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
-    elbows = {name: apply_transform(points[name], to_mesh)[0] for name in ELBOWS if name in points}
+    # The wrists of the standard skeleton the body gets, not the network's raw ones: read from the mesh
+    # (wrists past the forearm's narrowest section), they hold on a raised or bent arm too.
+    skeleton = skeleton_from_votes(votes, template=HOLDING_KIND, fingers=False, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    wrists = {name: found[name] for name in WRISTS if name in found}
+    elbows = {name: found[name] for name in ELBOWS if name in found}
     size = largest_side(body.vertices)
     # Has the body hands of its own? Asked without every thick object at a wrist: a hand that is an object
     # of its own and what it holds alike.
