@@ -215,7 +215,7 @@ def test_a_sword_in_a_hand_raised_60_degrees_is_held_there():
     standard skeleton's, read from the mesh: the network's own right wrist lay 0.09 short of the hand,
     past a hand's reach of where the blade touches it (measured)."""
     body, heads = procedural_biped_posed({"upper_arm.R": ((0.0, 1.0, 0.0), 60.0)})
-    hand = heads["hand.R"] + 0.5 * (heads["hand.R"] - heads["forearm.R"]) / 2.0  # the palm, past the wrist
+    hand = heads["hand.R"] + 0.25 * (heads["hand.R"] - heads["forearm.R"])  # the palm: a quarter forearm past the wrist
     sword = box_mesh(hand + [-0.008, -0.5, -0.008], hand + [0.008, 0.03, 0.008], 0.02)
     mesh = Mesh.concatenate([body, Mesh(sword.vertices, sword.triangles, object_names=("Sword",))])
     (prop,) = props_held_at_hands(mesh)

@@ -414,6 +414,24 @@ def test_a_limb_is_mirror_symmetric_where_its_shape_is():
     assert limb_mirror_error(cKDTree(arm), np.array([5.0, 0.0, 0.0]), np.array([-5.0, 0.0, 0.0])) == 0.0
 
 
+def test_a_nearly_symmetric_shape_s_far_twins_are_mirrored_only_where_the_shape_is_symmetric():
+    """symmetrised with the shape's vertices: wrists 0.2 apart are mirrored where both arms are there
+    (the network's error), and kept where the right arm is raised (its vertices have no twin)."""
+    arm = box_mesh([0.1, -0.03, 0.6], [0.5, 0.03, 0.66], 0.02).vertices
+    points = {"wrist.L": np.array([0.45, 0.0, 0.63]), "wrist.R": np.array([-0.3, 0.0, 0.55]),
+              "hips": np.array([0.01, 0.0, 0.3])}
+    assert np.linalg.norm(points["wrist.L"] - points["wrist.R"] * [-1, 1, 1]) > SYMMETRIC_PAIR_DISTANCE
+    both = symmetrised(points, True, np.vstack([arm, arm * [-1.0, 1.0, 1.0]]))
+    np.testing.assert_allclose(both["wrist.L"], [0.375, 0.0, 0.59])
+    np.testing.assert_allclose(both["wrist.R"], [-0.375, 0.0, 0.59])
+    raised_arm = arm * [-1.0, 1.0, 1.0] + [0.0, 0.0, 0.3]
+    raised = {**points, "wrist.R": np.array([-0.45, 0.0, 0.93])}
+    kept = symmetrised(raised, True, np.vstack([arm, raised_arm]))
+    np.testing.assert_array_equal(kept["wrist.L"], raised["wrist.L"])
+    np.testing.assert_array_equal(kept["wrist.R"], raised["wrist.R"])
+    assert kept["hips"][0] == 0.0  # the midline is still the mirror plane's
+
+
 @pytest.mark.parametrize("degrees, mirrored", [(60.0, False), (5.0, True)])
 def test_an_arm_raised_on_purpose_keeps_its_place_and_one_raised_a_little_is_mirrored(degrees, mirrored):
     """The procedural biped with its right arm raised: the shape is nearly symmetric as a whole (one arm

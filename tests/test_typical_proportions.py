@@ -5,6 +5,8 @@ short-legged biped whose hip joints and a big-headed one whose neck the
 landmark network puts far too high at first, and hip joints read below the
 crotch raised to it."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -19,7 +21,7 @@ from autorig_addon.core.rigging.standard_skeleton import Landmarks
 from autorig_addon.core.rigging.typical_proportions import (
     HeightMap,
     crotch_height,
-    hip_joints_not_below_crotch,
+    hip_joints_raised_to_crotch,
     neck_pinch,
     typical_proportions,
 )
@@ -273,11 +275,25 @@ def test_an_open_trunk_s_crotch_is_where_its_surface_encloses_the_line():
             == crotch_height(closed_solid, knees, 1.0))
 
 
+def test_legs_inside_a_robe_open_at_the_bottom_keep_their_own_crotch():
+    """A robe, a tube open at the bottom from below the knees up to the trunk, encloses the line from
+    the hem up: that is no crotch, so the legs' own fork (in the solid) stays the crotch."""
+    legs = [box_mesh([side * 0.1 - 0.05, -0.05, 0.0], [side * 0.1 + 0.05, 0.05, 0.45], 0.05) for side in (-1, 1)]
+    trunk = box_mesh([-0.2, -0.08, 0.45], [0.2, 0.08, 1.0], 0.05)
+    tube = box_mesh([-0.3, -0.15, 0.05], [0.3, 0.15, 0.6], 0.05)
+    bottom = np.all(np.isclose(tube.vertices[tube.triangles][:, :, 2], 0.05), axis=1)
+    mesh = joined(*legs, trunk, Mesh(tube.vertices, tube.triangles[~bottom]))
+    solid = solid_depth(mesh)
+    knees = np.array([[0.1, 0.0, 0.22], [-0.1, 0.0, 0.22]])
+    assert enclosed_by(mesh)(knees.mean(axis=0)[None])[0]  # the line starts inside the robe
+    assert crotch_height(solid, knees, 1.0, enclosed_by(mesh)) == crotch_height(solid, knees, 1.0)
+
+
 def test_hip_joints_read_below_the_crotch_are_raised_to_it_with_the_hips(block_body):
     points = {"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
               "hip.L": np.array([0.1, 0.01, 0.22]), "hip.R": np.array([-0.1, 0.01, 0.24]),
               "hips": np.array([0.0, 0.02, 0.2]), "neck": np.array([0.0, 0.0, 0.9])}
-    raised, lift = hip_joints_not_below_crotch(points, block_body, top=1.0)
+    raised, lift = hip_joints_raised_to_crotch(points, block_body, top=1.0)
     crotch = crotch_height(block_body, np.array([points["knee.L"], points["knee.R"]]), 1.0)
     # The middle of the hip joints (0.23) goes to the crotch (about 0.3); each keeps its offset, the hips too.
     assert lift == pytest.approx(crotch - 0.23)
@@ -288,22 +304,37 @@ def test_hip_joints_read_below_the_crotch_are_raised_to_it_with_the_hips(block_b
         np.testing.assert_array_equal(raised[name], points[name])
     # Hip joints at or above the crotch stay, and so does everything else.
     above = {**points, "hip.L": np.array([0.1, 0.0, 0.33]), "hip.R": np.array([-0.1, 0.0, 0.33])}
-    kept, lift = hip_joints_not_below_crotch(above, block_body, top=1.0)
+    kept, lift = hip_joints_raised_to_crotch(above, block_body, top=1.0)
     assert lift == 0.0 and kept is above
     # Knees above the trunk's top find no crotch: nothing moves.
     high_knees = {**points, "knee.L": np.array([0.1, 0.0, 0.85]), "knee.R": np.array([-0.1, 0.0, 0.85])}
-    assert hip_joints_not_below_crotch(high_knees, block_body, top=1.0)[1] == 0.0
+    assert hip_joints_raised_to_crotch(high_knees, block_body, top=1.0)[1] == 0.0
 
 
-def test_a_biped_s_landmarks_get_their_hip_joints_raised_in_the_prediction(block_body):
+def test_a_biped_s_landmarks_get_their_hip_joints_raised_in_the_prediction():
     """The step the prediction runs: a sure biped's landmarks raised on its open body, a quadruped's as they are."""
     mesh = open_bottomed_block_body()
     first = {name: np.zeros(3) for name in LANDMARKS}
     first.update({"knee.L": np.array([0.1, 0.0, 0.15]), "knee.R": np.array([-0.1, 0.0, 0.15]),
                   "hip.L": np.array([0.1, 0.0, 0.2]), "hip.R": np.array([-0.1, 0.0, 0.2]),
                   "hips": np.array([0.0, 0.0, 0.19])})
-    raised = predict._hip_joints_raised_to_crotch(mesh, solid_depth(mesh), Landmarks(first, SURE_BIPED))
+    raised = predict._raise_hip_joints_to_crotch(mesh, solid_depth(mesh), Landmarks(first, SURE_BIPED))
     assert CROTCH <= raised.points["hip.L"][2] <= CROTCH + 0.02
     assert raised.points["hips"][2] == pytest.approx(raised.points["hip.L"][2] - 0.01)
     quadruped = Landmarks(first, {"biped": 0.0, "quadruped": 0.95, "other": 0.05})
-    assert predict._hip_joints_raised_to_crotch(mesh, solid_depth(mesh), quadruped) is quadruped
+    assert predict._raise_hip_joints_to_crotch(mesh, solid_depth(mesh), quadruped) is quadruped
+
+
+def test_the_prediction_raises_the_hip_joints_it_reads(monkeypatch):
+    """predict_votes hands its landmarks to the raise and keeps what it returns."""
+    raised = []
+
+    def spy(normalised, solid, landmarks):
+        moved = {**landmarks.points, "hip.L": landmarks.points["hip.L"] + [0.0, 0.0, 0.05]}
+        raised.append(moved["hip.L"])
+        return replace(landmarks, points=moved)
+
+    monkeypatch.setattr(predict, "_raise_hip_joints_to_crotch", spy)
+    votes = predict_votes(short_legged_biped()[0])
+    assert len(raised) == 1
+    np.testing.assert_array_equal(votes.landmarks.points["hip.L"], raised[0])

@@ -18,8 +18,9 @@ where they touch the body does. Here:
 2. **held at the hands** (:func:`held_at_hands`): the landmark network reads
    the body without the thin candidates; a candidate is held when most of where
    it touches the body (:data:`AT_HAND_SHARE`) lies within
-   :data:`HAND_REACH` of the body's largest side of a wrist, on a body read
-   as a biped (surely, or by its nearest known body), and most of it reaches beyond that
+   :data:`HAND_REACH` of the body's largest side of a wrist (the standard
+   biped skeleton's, read from the mesh, so a raised arm's hand holds too),
+   on a body read as a biped (surely, or by its nearest known body), and most of it reaches beyond that
    (:data:`BEYOND_HAND_SHARE`). Wings and ears touch the back and the head;
    a cape the neck; a hand, a glove or a gauntlet of its own (or both hands
    in one object, which is thin across the two) lies within a hand's reach
@@ -48,6 +49,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..dataset.normalise import apply_transform
 from ..errors import InputError
 from ..geometry.bounding_box import largest_side
 from ..geometry.closest_point import TriangleMeshQuery
@@ -73,7 +75,7 @@ AT_HAND_SHARE = 0.5
 #: from that wrist: a blade, a staff or a shield reaches out of the hand; a
 #: hand, a glove or a short claw does not (they stay the body's).
 BEYOND_HAND_SHARE = 0.5
-#: The wrists and elbows of the body's standard biped skeleton, left and right (core.skeleton.key_joints).
+#: The wrists and elbows, left and right (core.skeleton.key_joints).
 WRISTS = ("wrist.L", "wrist.R")
 ELBOWS = ("elbow.L", "elbow.R")
 #: A hand of the body's own goes on at least this share of the body's largest side past its wrist (a
@@ -346,18 +348,25 @@ def props_held_at_hands_reading(mesh: Mesh, left_out: np.ndarray | None = None, 
     reading = BodyReading(body, votes)
     if sure_standard_kind(votes.landmarks) != HOLDING_KIND:
         return (), reading
-    # The wrists of the standard skeleton the body gets, not the network's raw ones: read from the mesh
-    # (wrists past the forearm's narrowest section), they hold on a raised or bent arm too.
+    size = largest_side(body.vertices)
+    # A thin candidate is looked for at the wrists of the standard biped skeleton, read from the mesh (past
+    # the forearm's narrowest section), which follow a raised or bent arm where the network's fall short.
     skeleton = skeleton_from_votes(votes, template=HOLDING_KIND, fingers=False, known_rig=False)
     found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
-    wrists = {name: found[name] for name in WRISTS if name in found}
-    elbows = {name: found[name] for name in ELBOWS if name in found}
-    size = largest_side(body.vertices)
+    thin = held_at_hands([candidate for candidate in candidates if candidate.thin],
+                         {name: found[name] for name in WRISTS if name in found}, size)
+    # A thick one at the network's own wrists, on which HAND_PAST and HELD_PAST were chosen.
+    points = votes.landmarks.points_for(HOLDING_KIND)
+    to_mesh = np.linalg.inv(votes.transform)
+    wrists = {name: apply_transform(points[name], to_mesh)[0] for name in WRISTS if name in points}
+    elbows = {name: apply_transform(points[name], to_mesh)[0] for name in ELBOWS if name in points}
     # Has the body hands of its own? Asked without every thick object at a wrist: a hand that is an object
     # of its own and what it holds alike.
     without = rows.copy()
-    for candidate in candidates:
-        if not candidate.thin and at_a_wrist(candidate, wrists, size):
+    thick = [candidate for candidate in candidates if not candidate.thin]
+    for candidate in thick:
+        if at_a_wrist(candidate, wrists, size):
             without[mesh.object_slice(candidate.object_index)] = False
     hands = own_hands(wrists, elbows, mesh.vertices[without], size)
-    return held_at_hands(candidates, wrists, size, hands), reading
+    held = thin + held_at_hands(thick, wrists, size, hands)
+    return tuple(sorted(held, key=lambda prop: prop.object_index)), reading

@@ -67,7 +67,7 @@ from .tree_features import candidate_pairs, pair_features, root_features
 from .typical_proportions import (
     TYPICAL_CROTCH_SHARE,
     TYPICAL_NECK_SHARE,
-    hip_joints_not_below_crotch,
+    hip_joints_raised_to_crotch,
     points_back,
     stretched,
     typical_proportions,
@@ -275,7 +275,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
-    landmarks = _hip_joints_raised_to_crotch(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
+    landmarks = _raise_hip_joints_to_crotch(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     near = landmarks.closest_rig or nearest
@@ -336,16 +336,16 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
     return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
 
 
-def _hip_joints_raised_to_crotch(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> Landmarks:
-    """A biped's landmarks with the hip joints (and the hips) no lower than
-    the crotch of its body (``normalised``, ``solid``: as
-    :func:`_read_again_at_typical_proportions` takes them;
-    :func:`.typical_proportions.hip_joints_not_below_crotch`); other
-    landmarks as they are."""
+def _raise_hip_joints_to_crotch(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> Landmarks:
+    """A biped's landmarks with the middle of its hip joints (and the hips
+    with them) raised to the crotch of its body when read below it
+    (:func:`.typical_proportions.hip_joints_raised_to_crotch`; ``normalised``
+    and ``solid`` as :func:`_read_again_at_typical_proportions` takes them);
+    other landmarks as they are."""
     if sure_standard_kind(landmarks) != BIPED:
         return landmarks
     top = float(normalised.vertices[:, 2].max())
-    points, lift = hip_joints_not_below_crotch(landmarks.points, solid, top, enclosed_by(normalised))
+    points, lift = hip_joints_raised_to_crotch(landmarks.points, solid, top, enclosed_by(normalised))
     return replace(landmarks, points=points) if lift > 0.0 else landmarks
 
 

@@ -11,7 +11,7 @@ out where those bodies have it:
   31 %): the hips, the hip joints, the shoulders and the head 0.1 to 0.2 of
   the height too high, while the knees and ankles, read from the legs
   themselves, stay in place. The crotch tells it: the first point inside
-  the solid straight above the middle of the knees (:func:`crotch_height`);
+  the body straight above the middle of the knees (:func:`crotch_height`);
   the landmarks put the hip joints more than :data:`HIP_ABOVE_CROTCH`
   crotch heights above it.
 * **big heads** (Quaternius' animated characters: the head a third of the
@@ -88,31 +88,36 @@ def crotch_height(solid: SolidDepth, knees: np.ndarray, top: float, enclosed=Non
     above them and below ``CROTCH_SEARCH_TOP * top``; None when there is
     none (legs that meet nowhere, a long robe's open bottom).
 
-    Inside is inside the solid or, given ``enclosed`` (``(k, 3) points ->
-    (k,) bool``, :func:`.quality.enclosed_by` of the normalised proxy),
-    enclosed by the surface: the solid of a trunk with a hole in it (a
-    low-poly body whose legs are objects of their own) leaks to a shell, and
-    the line would meet it only at the shoulders."""
+    Inside is at least half a cell deep in the solid or, given ``enclosed``
+    (``(k, 3) points -> (k,) bool``, :func:`.quality.enclosed_by` of the
+    normalised proxy), a point the solid reads nothing at (depth 0) that the
+    surface encloses: the solid of a trunk with a hole in it (a low-poly body
+    whose legs are objects of their own) leaks to a shell, and the line would
+    meet it only at the shoulders. Not when the line starts enclosed: legs
+    standing inside a robe or a skirt open at the bottom are enclosed from
+    the hem up, and that is no crotch."""
     middle = np.mean(np.asarray(knees, dtype=np.float64), axis=0)
     heights = np.arange(middle[2], CROTCH_SEARCH_TOP * top, 0.5 * solid.cell_size)
     if not len(heights):
         return None
     line = np.column_stack([np.zeros_like(heights), np.full_like(heights, middle[1]), heights])
+    depth = solid.at(line)
     # Half a cell deep: inside the solid, not in the interpolated fringe around it.
-    inside = solid.at(line) >= 0.5 * solid.cell_size
+    inside = depth >= 0.5 * solid.cell_size
     first = int(np.argmax(inside)) if inside.any() else len(heights)
     if enclosed is not None and first > 0:
         # Only the points below the solid's first one can come first; the winding number costs per point.
-        below = np.asarray(enclosed(line[:first]), dtype=bool)
-        if below.any():
-            first = int(np.argmax(below))
+        hollow = np.asarray(enclosed(line[:first]), dtype=bool) & (depth[:first] <= 0.0)
+        if hollow.any() and not hollow[0]:
+            first = int(np.argmax(hollow))
     return float(heights[first]) if first < len(heights) else None
 
 
-def hip_joints_not_below_crotch(points: dict, solid: SolidDepth, top: float, enclosed=None) -> tuple[dict, float]:
+def hip_joints_raised_to_crotch(points: dict, solid: SolidDepth, top: float, enclosed=None) -> tuple[dict, float]:
     """A biped's landmarks with the hip joints, and the hips with them,
-    raised to the crotch (:func:`crotch_height`) when the network put them
-    below it; also how far they were raised (0 when not). A thigh's head
+    raised together until the middle of the hip joints is at the crotch
+    (:func:`crotch_height`) when the network put it below; also how far they
+    were raised (0 when not). A thigh's head
     lies in the pelvis, above the fork of the legs: of the 177 training
     bipeds whose crotch is found, the artists put the hip joints below it on
     6 (four of them Nexuiz's, 0.012 to 0.125 of the height below). Raised so,
