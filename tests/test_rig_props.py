@@ -14,7 +14,13 @@ import pytest
 
 from autorig_addon.blender import convert, scene_io
 from autorig_addon.blender.armature_builder import build_armature
-from autorig_addon.blender.jobs.rig import HANDS_READING_LABEL, plan_rig_steps, planned_rig_steps, run_steps
+from autorig_addon.blender.jobs.rig import (
+    HANDS_READING_LABEL,
+    HANDS_READING_SHARE,
+    plan_rig_steps,
+    planned_rig_steps,
+    run_steps,
+)
 from autorig_addon.blender.jobs.skin import SkinSettings
 from autorig_addon.cli.main import main
 from autorig_addon.core.errors import Cancelled
@@ -444,6 +450,15 @@ def test_auto_rig_binds_a_sword_in_each_hand_wholly_to_its_hand_without_a_rig(cl
 MUG_LOW, MUG_HIGH = (-0.33, -0.06, 0.50), (-0.27, 0.0, 0.58)
 
 
+def add_mirrored_mugs() -> list:
+    """A mug in each hand (MUG_LOW, MUG_HIGH and its mirror image), objects of their own."""
+    right = box_mesh(np.array(MUG_LOW), np.array(MUG_HIGH), 0.01)
+    mugs = [mesh_object("Mug", right.vertices, right.triangles),
+            mesh_object("Mug.L", right.vertices * [-1.0, 1.0, 1.0], right.triangles[:, ::-1])]
+    bpy.context.view_layer.update()
+    return mugs
+
+
 def test_auto_rig_binds_a_mug_in_each_hand_wholly_to_its_hand(clean_scene, capfd):
     """A mug in each hand, mirror images: not thin, so before they stayed
     part of the body (a twin each) and were skinned over the hand and the
@@ -453,11 +468,7 @@ def test_auto_rig_binds_a_mug_in_each_hand_wholly_to_its_hand(clean_scene, capfd
     without bending it."""
     names_alone, _ = bones_of_the_biped_alone()
     body = add_biped()
-    low, high = np.array(MUG_LOW), np.array(MUG_HIGH)
-    right = box_mesh(low, high, 0.01)
-    mugs = [mesh_object("Mug", right.vertices, right.triangles),
-            mesh_object("Mug.L", right.vertices * [-1.0, 1.0, 1.0], right.triangles[:, ::-1])]
-    bpy.context.view_layer.update()
+    mugs = add_mirrored_mugs()
     select_only([body, *mugs], active=body)
 
     assert bpy.ops.autorig.auto_rig() == {"FINISHED"}
@@ -543,6 +554,29 @@ def test_esc_while_the_hands_are_read_stops_the_run_with_the_scene_as_it_was(cle
     assert any("network" in message for message in reported)
     assert armatures() == []
     assert scene_state([body, sword, offhand]) == before
+
+
+@pytest.mark.parametrize("held", ["swords", "mugs"])
+def test_a_run_that_reads_the_hands_fills_one_progress_bar(clean_scene, monkeypatch, held):
+    """Reading what the hands hold, then rigging and binding: the bar fills once, never starting again from
+    empty. The reading takes the first HANDS_READING_SHARE of it, labelled; the rig's prediction and skin
+    the rest. With swords the rig uses that reading; held mugs leave another body to read (the bar went
+    0 to 1 twice before)."""
+    readings = counted_readings(monkeypatch)
+    body = add_biped()
+    objects = [body, *(add_mirrored_swords() if held == "swords" else add_mirrored_mugs())]
+    reported = []
+    steps = planned_rig_steps(bpy.context, plan_rig_steps(objects, bpy.context.evaluated_depsgraph_get(), "Biped",
+                                                          skin=SkinSettings()))
+    run_steps(steps, lambda fraction, message: reported.append((fraction, message)))
+
+    assert len(readings) == (1 if held == "swords" else 2)
+    fractions = [fraction for fraction, _ in reported]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    reading = [fraction for fraction, message in reported if message.startswith(HANDS_READING_LABEL)]
+    assert reading and max(reading) == pytest.approx(HANDS_READING_SHARE)
+    rest = [fraction for fraction, message in reported if not message.startswith(HANDS_READING_LABEL)]
+    assert rest and min(rest) >= HANDS_READING_SHARE
 
 
 def test_a_held_sword_already_bound_is_refused_before_the_hands_are_read(clean_scene, monkeypatch):

@@ -250,8 +250,11 @@ _PREDICTIONS: OrderedDict[str, _Prediction] = OrderedDict()
 
 #: A step's task, run by a worker (the operators) or on this thread (:func:`run_steps`).
 Task = Callable[[ProgressCallback | None], object]
-#: What the progress says while the body is read to tell what its hands hold.
+#: What the progress says while the body is read to tell what its hands hold ...
 HANDS_READING_LABEL = "Telling what the hands hold"
+#: ... and the share of the progress bar that reading takes in a whole run (:func:`planned_rig_steps`):
+#: one pass of the prediction, as the rig's own, which it often spares.
+HANDS_READING_SHARE = 0.3
 
 
 def plan_rig(meshes: list, depsgraph, name: str, settings: RigSettings = RigSettings(), *,
@@ -586,9 +589,39 @@ def planned_rig_steps(context, plan_steps: Generator[Task, object, RigPlan], *,
                       remember: bool = True) -> Generator[Task, object, RigResult]:
     """``plan_steps`` (:func:`plan_rig_steps`) then :func:`rig_steps` on the plan they
     return, as one run of steps: an operator started on them runs every slow
-    part in its worker, the reading that tells what the hands hold too."""
-    plan = yield from plan_steps
-    return (yield from rig_steps(context, plan, remember=remember))
+    part in its worker, the reading that tells what the hands hold too.
+
+    One progress bar for the whole run: when the planning reads the body (a
+    character of several objects), its task fills the first
+    :data:`HANDS_READING_SHARE` of the bar and the rig's steps the rest, so
+    the bar never starts again from empty."""
+    read = []
+    plan = yield from _progress_within(plan_steps, 0.0, HANDS_READING_SHARE, read)
+    return (yield from _progress_within(rig_steps(context, plan, remember=remember),
+                                        HANDS_READING_SHARE if read else 0.0, 1.0, []))
+
+
+def _progress_within(steps: Generator[Task, object, object], start: float, end: float, yielded: list):
+    """``steps`` with each task's progress mapped onto [``start``, ``end``] of the
+    bar (:func:`...core.progress.sub_progress`); results and exceptions (Esc,
+    the generator closed) pass through to ``steps`` as :func:`run_steps` and the
+    operators give them. Appends to ``yielded`` for each task yielded."""
+    try:
+        task = steps.send(None)
+        while True:
+            yielded.append(task)
+            try:
+                result = yield _within(task, start, end)
+            except BaseException as error:  # the steps clean up and re-raise (GeneratorExit on close too)
+                task = steps.throw(error)
+            else:
+                task = steps.send(result)
+    except StopIteration as stop:
+        return stop.value
+
+
+def _within(task: Task, start: float, end: float) -> Task:
+    return lambda progress: task(sub_progress(progress, start, end))
 
 
 def _followed_armatures(meshes) -> list:
