@@ -118,8 +118,8 @@ def hip_joints_raised_to_crotch(points: dict, solid: SolidDepth, top: float, enc
     raised together until the middle of the hip joints is at the crotch
     (:func:`crotch_height`) when the network put it below; also how far they
     were raised (0 when not). A thigh's head
-    lies in the pelvis, above the fork of the legs: of the 177 training
-    bipeds whose crotch is found, the artists put the hip joints below it on
+    lies in the pelvis, above the fork of the legs: of the 163 training
+    bipeds (of 177) whose crotch is found, the artists put the hip joints below it on
     6 (four of them Nexuiz's, 0.012 to 0.125 of the height below). Raised so,
     4 training bipeds change, 2 of them with more key joints right and none
     with fewer (2026-12-07); on chibi bodies unlike the training ones (a big
