@@ -117,6 +117,15 @@ def test_a_biped_with_fingers_gets_fifteen_finger_bones_a_hand_and_without_the_s
     assert not any(name.startswith(("thumb", "f_")) for name in plain.names)
 
 
+def test_the_finger_switch_moves_no_other_joint(fingered_votes):
+    # Fingers are detail: with or without them the arms are read on the same mesh, so no key joint moves.
+    fingered = skeleton_from_votes(fingered_votes, template="biped")
+    plain = skeleton_from_votes(fingered_votes, template="biped", fingers=False)
+    index = {name: k for k, name in enumerate(fingered.names)}
+    for k, name in enumerate(plain.names):
+        np.testing.assert_allclose(fingered.joints[index[name]], plain.joints[k], atol=1e-12, err_msg=name)
+
+
 def test_the_procedural_biped_has_mitten_hands_so_no_fingers_and_a_note():
     votes = predict_votes(generate_character(0, "biped").mesh)
     skeleton = skeleton_from_votes(votes, template="biped")

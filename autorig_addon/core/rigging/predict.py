@@ -594,8 +594,8 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
                         apply_transform(rig.tails, to_mesh), rig.deform)
     if kind != FREE_FORM:
         nearly_symmetric = symmetry and mirror_error(votes.proxy_vertices, 0) <= NEAR_SYMMETRIC_ERROR
-        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric,
-                                     votes.surface if fingers else None)
+        skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric, votes.surface,
+                                     fingers)
         return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
                         preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))
     if not MIN_BANDWIDTH <= bandwidth <= MAX_BANDWIDTH:

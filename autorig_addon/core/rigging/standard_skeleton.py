@@ -49,6 +49,7 @@ from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import JointGraph
+from .limb_sections import limb_joints_centred
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS, STANDARD_KINDS
 from .rig_library import ClosestRig, KnownRelative
@@ -601,22 +602,26 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
 
 
 def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool,
-                      surface: Mesh | None = None) -> Skeleton:
+                      surface: Mesh | None = None, fingers: bool = False) -> Skeleton:
     """The standard skeleton of ``kind`` (biped or quadruped) around the
-    landmarks, in the normalised frame; a biped gets fingers when
-    ``surface`` (the full-resolution mesh, normalised) is given and both
-    hands have separable ones (:func:`both_hands_fingers`)."""
+    landmarks, in the normalised frame. A biped's limbs are read on
+    ``surface`` (the full-resolution mesh, normalised; the proxy's
+    ``vertices`` alone without it), whether or not it gets ``fingers``: it
+    gets them when asked and both hands have separable ones
+    (:func:`both_hands_fingers`)."""
     points = symmetrised(landmarks.points_for(kind), symmetric_shape, vertices)
     if kind == BIPED and landmarks.copied_for(kind) is None:
         # These correct where the network puts a biped's joints; an artist's rig copied whole is left as it is.
         points = head_near_neck(hips_at_most_at_hip_joints(points))
-        # Each arm is read on its own side; a symmetric shape's shoulders and wrists stay mirror images.
+        # Each limb is read on its own side; a symmetric shape's limbs stay mirror images.
         arms_from = vertices if surface is None else surface.vertices
-        points = symmetrised(wrists_past_narrowest_forearm(shoulders_on_arm_axes(points, vertices), arms_from),
-                             symmetric_shape, vertices)
+        points = wrists_past_narrowest_forearm(shoulders_on_arm_axes(points, vertices), arms_from)
+        if surface is not None:
+            points = limb_joints_centred(points, surface)
+        points = symmetrised(points, symmetric_shape, vertices)
     if kind == BIPED:
-        fingers = both_hands_fingers(points, surface, symmetric_shape) if surface is not None else None
-        return biped_skeleton(points, vertices, fingers)
+        found = both_hands_fingers(points, surface, symmetric_shape) if fingers and surface is not None else None
+        return biped_skeleton(points, vertices, found)
     if kind == QUADRUPED:
         if landmarks.copied_for(kind) is None:
             points = symmetrised(hind_legs_over_their_feet(points, vertices), symmetric_shape, vertices)
