@@ -7,6 +7,11 @@ and say so in the commit::
 
     .venv/bin/python tests/network_outputs.py
 
+When only the skeleton's construction changes on purpose (the networks'
+outputs unchanged), record the predicted skeleton alone, and say why::
+
+    .venv/bin/python tests/network_outputs.py --skeleton
+
 It writes :data:`NETWORK_OUTPUTS_FILE` (float32 outputs, about 150 kB):
 
 * each skinning network's candidate weights on the network graph of the
@@ -108,8 +113,12 @@ def skeleton_outputs() -> dict:
             "skeleton.names": np.asarray(skeleton.names)}
 
 
-def record() -> None:
-    arrays = {**skin_outputs(), **rig_outputs(), **skeleton_outputs()}
+def record(skeleton_only: bool = False) -> None:
+    if skeleton_only:
+        with np.load(NETWORK_OUTPUTS_FILE) as recorded:
+            arrays = {**{name: recorded[name] for name in recorded.files}, **skeleton_outputs()}
+    else:
+        arrays = {**skin_outputs(), **rig_outputs(), **skeleton_outputs()}
     NETWORK_OUTPUTS_FILE.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(NETWORK_OUTPUTS_FILE, **arrays)
     print(f"{len(arrays)} arrays in {NETWORK_OUTPUTS_FILE} ({NETWORK_OUTPUTS_FILE.stat().st_size / 1e3:.0f} kB)",
@@ -117,4 +126,4 @@ def record() -> None:
 
 
 if __name__ == "__main__":
-    record()
+    record(skeleton_only="--skeleton" in sys.argv[1:])

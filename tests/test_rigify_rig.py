@@ -223,8 +223,13 @@ def test_a_biped_with_fingers_gets_rigify_fingers_on_its_knuckles_that_curl_towa
     assert np.linalg.norm(tail_after - tail_before) > 0.4 * length
     assert tail_after[2] < tail_before[2] - 0.2 * length
     moved = np.linalg.norm(evaluated_world_vertices(obj) - rest, axis=1)
-    near_tip = np.linalg.norm(rest - tails["f_index.03.L"], axis=1) < 0.3 * length
-    near_middle_tip = np.linalg.norm(rest - tails["f_middle.03.L"], axis=1) < 0.3 * length
+    # A fingertip's vertices: near its tip and nearer to it than to another finger's (the box fingers lie 6 mm apart).
+    tips = np.array([tails[f"{finger}.03.L"] for finger in FINGERS])
+    to_tips = np.linalg.norm(rest[:, None, :] - tips[None], axis=2)
+    nearest_tip = np.argmin(to_tips, axis=1)
+    near_tip = (to_tips[:, FINGERS.index("f_index")] < 0.3 * length) & (nearest_tip == FINGERS.index("f_index"))
+    near_middle_tip = ((to_tips[:, FINGERS.index("f_middle")] < 0.3 * length)
+                       & (nearest_tip == FINGERS.index("f_middle")))
     assert near_tip.sum() >= 4 and np.median(moved[near_tip]) > 0.3 * length
     assert np.median(moved[near_middle_tip]) < 0.05 * length
     assert moved[rest[:, 0] < -0.1].max() < 1e-6  # the right side stays
