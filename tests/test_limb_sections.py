@@ -62,6 +62,24 @@ def test_a_hanging_arm_is_centred_on_itself_not_on_the_chest_beside_it():
     np.testing.assert_allclose(centred["elbow.L"], [0.14, 0.0, 0.47], atol=1e-12)
 
 
+def test_an_elbow_read_inside_the_chest_goes_to_the_arm_not_deeper_into_the_chest():
+    # The chest's outline runs across the middle, so cut at the side it is no limb even where it lies nearer.
+    body = _boxes(([-0.1, -0.05, 0.3], [0.1, 0.05, 0.7]), ([0.11, -0.03, 0.3], [0.17, 0.03, 0.65]))
+    points = _landmarks(arm_lift=0.0, knee_forward=0.0)
+    points.update({"shoulder.L": np.array([0.09, 0.0, 0.65]), "elbow.L": np.array([0.09, 0.0, 0.47]),
+                   "wrist.L": np.array([0.09, 0.0, 0.3])})
+    centred = limb_joints_centred(points, body)
+    np.testing.assert_allclose(centred["elbow.L"], [0.14, 0.0, 0.47], atol=1e-12)
+
+
+def test_a_skirt_round_both_legs_is_no_knee():
+    skirt = _boxes(([-0.12, -0.06, 0.05], [0.12, 0.06, 0.35]))
+    points = _landmarks(arm_lift=0.0, knee_forward=0.03)
+    centred = limb_joints_centred(points, skirt)
+    for side in (".L", ".R"):
+        np.testing.assert_array_equal(centred["knee" + side], points["knee" + side])
+
+
 def test_a_joint_far_from_any_limb_keeps_its_place():
     points = _landmarks(arm_lift=0.0, knee_forward=0.0)
     # An elbow further than MAX_MOVE of the upper arm's length from the arm's middle stays.

@@ -22,6 +22,7 @@ def test_a_box_cut_across_gives_its_square_outline():
 def test_vertices_on_the_plane_count_each_edge_in_it_once():
     # Spacing 0.25 puts rows of vertices at z = 0.5: the outline runs along the faces' edges there.
     section = plane_section(box_mesh([0, 0, 0], [1, 1, 1], 0.25), [0, 0, 0.5], [0, 0, 1])
+    assert len(np.unique(section.loops)) == 1
     np.testing.assert_allclose(section.lengths.sum(), 4.0, atol=1e-12)
     np.testing.assert_allclose(_centre(section), [0.5, 0.5, 0.5], atol=1e-12)
 

@@ -70,7 +70,8 @@ def plane_section(mesh: Mesh, point, normal) -> PlaneSection:
 
     starts, ends = crossing(first), crossing(second)
     # Loops: the cut edges are the nodes, each cut triangle joins its two. Vertices split at a UV or normal seam
-    # sit at the same place: an edge is named by its corners' places, so the loop runs on across the seam.
+    # sit at the same place: an edge is named by its corners' places, so the loop runs on across the seam (and
+    # separate parts that share a corner's place, or a cut through a vertex on the plane, join one loop).
     used = np.unique(np.concatenate([corner, first, second]))
     place = np.zeros(len(vertices), dtype=np.int64)
     place[used] = np.unique(vertices[used], axis=0, return_inverse=True)[1].reshape(-1)

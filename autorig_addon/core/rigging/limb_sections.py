@@ -30,7 +30,11 @@ MAX_MOVE = 0.6
 def limb_joints_centred(points: dict, surface: Mesh) -> dict:
     """A biped's landmarks (``points``, by role) with the joints of
     :data:`CENTRED_JOINTS` moved across their limb to the middle of its
-    outline on ``surface`` (the body's mesh, normalised as ``points``)."""
+    outline on ``surface`` (the body's mesh, normalised as ``points``).
+    In the order of :data:`CENTRED_JOINTS`: the wrist's cut is square to
+    the forearm from the elbow already centred, the better axis (read from
+    the elbow as the network put it, two of Quaternius' animated characters
+    lost a wrist on validation)."""
     points = dict(points)
     for start, joint, end in CENTRED_JOINTS:
         for side, sign in ((LEFT, 1.0), (RIGHT, -1.0)):
@@ -56,9 +60,13 @@ def _centred(points: dict, start: str, joint: str, end: str | None, surface: Mes
     if np.linalg.norm(direction) <= 1e-9:
         return None
     section = plane_section(surface, at, direction)
-    # The limb is the piece of the outline (its loop) nearest the joint, on the limb's own side: the cut also
-    # crosses the other leg, the chest beside a hanging arm, a hand's fingers.
-    section = section.keep(sign * section.midpoints[:, 0] > 0)
+    # The limb is the piece of the outline (its loop) nearest the joint among those wholly on the limb's own side:
+    # the cut also crosses the other leg, a hand's fingers, and the chest beside a hanging arm, or a skirt round
+    # both legs, whose loops run across the middle.
+    loop_count = int(section.loops.max()) + 1 if len(section.loops) else 0
+    crosses_middle = np.zeros(loop_count, dtype=bool)
+    crosses_middle[section.loops[sign * section.midpoints[:, 0] <= 0.0]] = True
+    section = section.keep(~crosses_middle[section.loops])
     if not len(section.loops):
         return None
     distances = paired_point_segment_distances(np.broadcast_to(at, section.starts.shape), section.starts,
