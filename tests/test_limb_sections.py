@@ -52,24 +52,21 @@ def test_joints_read_above_a_low_poly_arm_and_before_a_leg_move_onto_their_axes(
             np.testing.assert_array_equal(centred[role + side], points[role + side])
 
 
-def test_a_hanging_arm_is_centred_on_itself_not_on_the_chest_beside_it():
+def _left_arm_hanging_by_the_chest_read_at(x: float, y: float) -> dict:
+    """The left elbow of a chest with the left arm hanging beside it (the arm's axis at x 0.14, y 0), the arm's
+    landmarks read straight down through (x, y)."""
     body = _boxes(([-0.1, -0.05, 0.3], [0.1, 0.05, 0.7]), ([0.11, -0.03, 0.3], [0.17, 0.03, 0.65]))
     points = _landmarks(arm_lift=0.0, knee_forward=0.0)
-    # The arm read straight down but 0.02 outward and 0.02 behind its axis (x 0.14, y 0).
-    points.update({"shoulder.L": np.array([0.16, 0.02, 0.65]), "elbow.L": np.array([0.16, 0.02, 0.47]),
-                   "wrist.L": np.array([0.16, 0.02, 0.3])})
-    centred = limb_joints_centred(points, body)
-    np.testing.assert_allclose(centred["elbow.L"], [0.14, 0.0, 0.47], atol=1e-12)
+    points.update({f"{role}.L": np.array([x, y, z]) for role, z in (("shoulder", 0.65), ("elbow", 0.47),
+                                                                   ("wrist", 0.3))})
+    return limb_joints_centred(points, body)["elbow.L"]
 
 
-def test_an_elbow_read_inside_the_chest_goes_to_the_arm_not_deeper_into_the_chest():
-    # The chest's outline runs across the middle, so cut at the side it is no limb even where it lies nearer.
-    body = _boxes(([-0.1, -0.05, 0.3], [0.1, 0.05, 0.7]), ([0.11, -0.03, 0.3], [0.17, 0.03, 0.65]))
-    points = _landmarks(arm_lift=0.0, knee_forward=0.0)
-    points.update({"shoulder.L": np.array([0.09, 0.0, 0.65]), "elbow.L": np.array([0.09, 0.0, 0.47]),
-                   "wrist.L": np.array([0.09, 0.0, 0.3])})
-    centred = limb_joints_centred(points, body)
-    np.testing.assert_allclose(centred["elbow.L"], [0.14, 0.0, 0.47], atol=1e-12)
+@pytest.mark.parametrize("x, y", [(0.16, 0.02), (0.09, 0.0)], ids=["outward and behind", "inside the chest"])
+def test_a_hanging_arm_is_centred_on_itself_not_on_the_chest_beside_it(x, y):
+    # Read inside the chest, the chest's outline lies nearer, but it runs across the middle: no limb, so the elbow
+    # goes to the arm and not deeper into the chest.
+    np.testing.assert_allclose(_left_arm_hanging_by_the_chest_read_at(x, y), [0.14, 0.0, 0.47], atol=1e-12)
 
 
 def test_a_skirt_round_both_legs_is_no_knee():
