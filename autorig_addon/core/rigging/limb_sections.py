@@ -3,7 +3,8 @@
 Artists put a limb's joints on the limb's axis, the middle of its
 cross-section. The landmark network, on bodies unlike the training ones,
 puts them off it: on Quaternius' big-headed characters it read the elbows
-and wrists of arms held out level 0.05 to 0.06 above the arm, outside the
+and wrists of arms held out level above the arm's axis (a median 0.047 of
+the largest side for the elbows of the animated pack), some outside the
 body, drawn up toward the head that hangs over the shoulders. Each joint is
 moved, across its limb only, to the middle of the limb's outline in the
 plane through it square to the limb (:mod:`..geometry.plane_section`,
@@ -24,6 +25,7 @@ from ..types import Mesh
 #: joint to ``to`` (the bend's bisector), or the first alone without ``to``.
 CENTRED_JOINTS = (("shoulder", "elbow", "wrist"), ("elbow", "wrist", None), ("hip", "knee", "ankle"))
 #: A joint farther than this share of its parent limb from the middle keeps its place: the cut missed the limb.
+#: Set, not tuned: several limb radii, so a joint read on the limb's surface or just off it always moves.
 MAX_MOVE = 0.6
 
 
