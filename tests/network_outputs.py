@@ -126,4 +126,7 @@ def record(skeleton_only: bool = False) -> None:
 
 
 if __name__ == "__main__":
+    if set(sys.argv[1:]) - {"--skeleton"}:
+        # Anything else (a --help) must not overwrite the record.
+        sys.exit(f"usage: {Path(sys.argv[0]).name} [--skeleton]  (see the module docstring)")
     record(skeleton_only="--skeleton" in sys.argv[1:])

@@ -64,6 +64,7 @@ from .standard_skeleton import (
 )
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
+from .trunk_depth import trunk_joints_in_depth
 from .typical_proportions import (
     TYPICAL_CROTCH_SHARE,
     TYPICAL_NECK_SHARE,
@@ -276,6 +277,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
     landmarks = _raise_hip_joints_to_crotch(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
+    if sure_standard_kind(landmarks) == BIPED:
+        landmarks = replace(landmarks, points=trunk_joints_in_depth(landmarks.points, solid))
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     near = landmarks.closest_rig or nearest
