@@ -25,6 +25,7 @@ from autorig_addon.core.rigging.standard_skeleton import (
     biped_skeleton,
     head_near_neck,
     hind_legs_over_their_feet,
+    hip_joints_over_knees,
     hips_at_most_at_hip_joints,
     landmark_warnings,
     limb_mirror_error,
@@ -143,6 +144,20 @@ def test_a_bipeds_hips_come_down_to_its_hip_joints_never_up():
     assert points["hips"][2] == 0.55  # the caller's landmarks are left as they were
     below = dict(points, hips=np.array([0.0, 0.01, 0.42]))
     np.testing.assert_array_equal(hips_at_most_at_hip_joints(below)["hips"], [0.0, 0.01, 0.42])
+
+
+def test_a_bipeds_hip_joints_come_in_over_its_knees_never_out():
+    # The hips at x 0.01 (the midline); the left hip joint 0.08 out of it over a knee 0.05 out, the right one inside.
+    points = {"hips": np.array([0.01, 0.0, 0.5]), "hip.L": np.array([0.09, 0.02, 0.48]),
+              "knee.L": np.array([0.06, -0.01, 0.25]), "hip.R": np.array([-0.03, 0.02, 0.48]),
+              "knee.R": np.array([-0.07, -0.01, 0.25])}
+    drawn = hip_joints_over_knees(points)
+    # Across only, to the knee's distance from the midline: x 0.01 + 0.05; its depth and height stay.
+    np.testing.assert_allclose(drawn["hip.L"], [0.06, 0.02, 0.48], atol=1e-15)
+    # Nearer the midline than its knee (legs apart at the knees): it keeps its place; nothing else moves.
+    for role in ("hip.R", "hips", "knee.L", "knee.R"):
+        np.testing.assert_array_equal(drawn[role], points[role])
+    assert points["hip.L"][0] == 0.09  # the caller's landmarks are left as they were
 
 
 def test_a_bipeds_head_joint_is_drawn_toward_its_neck_to_a_neck_length():
