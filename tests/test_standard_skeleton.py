@@ -244,6 +244,10 @@ def test_warnings_name_key_joints_outside_the_body_and_a_leg_out_of_order():
     )
     quadruped = landmark_warnings(landmarks, QUADRUPED, inside)
     assert quadruped[0] == "check the skeleton: the left front ankle could not be placed inside the body"
+    # The hips read lower than the left knee (0.3): the trunk would hang from below it. A quadruped's may be.
+    low_hips = Landmarks({**points, "hips": np.array([0.0, 0.0, 0.28])}, landmarks.kind_probabilities)
+    assert landmark_warnings(low_hips, BIPED, inside)[-1] == "check the skeleton: the hips lie below a knee"
+    assert "check the skeleton: the hips lie below a knee" not in landmark_warnings(low_hips, QUADRUPED, inside)
 
 
 def arm_and_chest_vertices():

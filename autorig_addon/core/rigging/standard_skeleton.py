@@ -599,8 +599,8 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
 
     Returns
     -------
-    tuple of str: key joints outside the body, and a leg whose joints do not
-    go down from the hip to the ankle.
+    tuple of str: key joints outside the body, a leg whose joints do not
+    go down from the hip to the ankle, and a biped's hips below a knee.
     """
     placed = landmarks.points_for(kind)
     names = list(placed)
@@ -618,6 +618,10 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
                 notes.append(f"check the skeleton: the {_spoken(chain[0] + side, kind)}, "
                              f"{_spoken(chain[1] + side, kind)} and {_spoken(chain[2] + side, kind)} do not go "
                              "down the leg in order")
+    if kind == BIPED and placed["hips"][2] <= max(placed["knee" + LEFT][2], placed["knee" + RIGHT][2]):
+        # Of the 177 training humanoids' artists one put the hips below a knee (SuperTuxKart's Sara, a knee raised);
+        # read so on a body standing, the trunk hangs from below the knees (the posed GDQuest mannequin).
+        notes.append("check the skeleton: the hips lie below a knee")
     return tuple(notes)
 
 
