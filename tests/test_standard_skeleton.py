@@ -158,6 +158,9 @@ def test_a_bipeds_hip_joints_come_in_over_its_knees_never_out():
     for role in ("hip.R", "hips", "knee.L", "knee.R"):
         np.testing.assert_array_equal(drawn[role], points[role])
     assert points["hip.L"][0] == 0.09  # the caller's landmarks are left as they were
+    # Legs crossed, the left knee across the midline: it bounds nothing, the hip joint stays.
+    crossed = dict(points, **{"knee.L": np.array([-0.02, -0.01, 0.25])})
+    np.testing.assert_array_equal(hip_joints_over_knees(crossed)["hip.L"], points["hip.L"])
 
 
 def test_a_bipeds_head_joint_is_drawn_toward_its_neck_to_a_neck_length():
