@@ -147,10 +147,11 @@ def test_a_bipeds_hips_come_down_to_its_hip_joints_never_up():
 
 
 def test_a_bipeds_hip_joints_come_in_over_its_knees_never_out():
-    # The hips at x 0.01 (the midline); the left hip joint 0.08 out of it over a knee 0.05 out, the right one inside.
-    points = {"hips": np.array([0.01, 0.0, 0.5]), "hip.L": np.array([0.09, 0.02, 0.48]),
-              "knee.L": np.array([0.06, -0.01, 0.25]), "hip.R": np.array([-0.03, 0.02, 0.48]),
-              "knee.R": np.array([-0.07, -0.01, 0.25])}
+    # The hip joints at x 0.09 and -0.07: the midline at 0.01. The left one 0.08 out of it over a knee 0.05 out; the
+    # right one 0.08 out over a knee 0.09 out.
+    points = {"hips": np.array([0.0, 0.0, 0.5]), "hip.L": np.array([0.09, 0.02, 0.48]),
+              "knee.L": np.array([0.06, -0.01, 0.25]), "hip.R": np.array([-0.07, 0.02, 0.48]),
+              "knee.R": np.array([-0.08, -0.01, 0.25])}
     drawn = hip_joints_over_knees(points)
     # Across only, to the knee's distance from the midline: x 0.01 + 0.05; its depth and height stay.
     np.testing.assert_allclose(drawn["hip.L"], [0.06, 0.02, 0.48], atol=1e-15)
@@ -158,6 +159,9 @@ def test_a_bipeds_hip_joints_come_in_over_its_knees_never_out():
     for role in ("hip.R", "hips", "knee.L", "knee.R"):
         np.testing.assert_array_equal(drawn[role], points[role])
     assert points["hip.L"][0] == 0.09  # the caller's landmarks are left as they were
+    # The right side the same way: a knee 0.03 out of the midline brings its hip joint to x 0.01 - 0.03.
+    narrow = dict(points, **{"knee.R": np.array([-0.02, -0.01, 0.25])})
+    np.testing.assert_allclose(hip_joints_over_knees(narrow)["hip.R"], [-0.02, 0.02, 0.48], atol=1e-15)
     # Legs crossed, the left knee across the midline: it bounds nothing, the hip joint stays.
     crossed = dict(points, **{"knee.L": np.array([-0.02, -0.01, 0.25])})
     np.testing.assert_array_equal(hip_joints_over_knees(crossed)["hip.L"], points["hip.L"])

@@ -219,22 +219,24 @@ def hips_at_most_at_hip_joints(points: dict) -> dict:
 
 def hip_joints_over_knees(points: dict) -> dict:
     """A biped's landmarks with each hip joint drawn across toward the
-    midline (the hips' x), x only, until it lies no farther from it than its
-    knee: a thigh does not splay outward going up. Artists' never do by more
+    midline (the middle of the two hip joints), x only, until it lies no
+    farther from it than its knee: a thigh does not splay outward going up. Artists' never do by more
     than 0.0075 of the largest side (the 177 training humanoids' 354 hip
     joints, from the middle of the two: a median 0.78 of their knee's
     distance; SuperTuxKart's beach woman's right one the widest); on
     short-legged bodies unlike the training ones the network put the hip
     joints 1.05 to 1.67 times as far apart as the knees (Quaternius'
     monsters a median 1.26), 0.03 to 0.06 too wide.
-    Run after the knees are centred in their legs; a knee across the
-    midline (legs crossed) leaves its hip joint as it is."""
+    Run after the knees are centred in their legs (when the mesh is given,
+    :func:`.limb_sections.limb_joints_centred`). A hip joint and its knee on
+    opposite sides of the midline (legs crossed), or either on it, are left
+    as they are: the knee bounds nothing there."""
     points = dict(points)
-    midline = float(points["hips"][0])
+    midline = 0.5 * float(points["hip" + LEFT][0] + points["hip" + RIGHT][0])
     for side in (LEFT, RIGHT):
         hip_joint, knee = points["hip" + side], points["knee" + side]
         if (hip_joint[0] - midline) * (knee[0] - midline) <= 0.0:
-            continue  # the knee across the midline (legs crossed) bounds nothing on this side
+            continue  # on opposite sides of the midline, or on it: no bound
         reach = abs(float(knee[0]) - midline)
         if abs(float(hip_joint[0]) - midline) > reach:
             points["hip" + side] = np.array([midline + np.sign(hip_joint[0] - midline) * reach, hip_joint[1],

@@ -4,15 +4,18 @@ Artists put the hips, the hip joints, the shoulders, the neck and the head
 near the middle of the body front to back. Measured on the training
 humanoids' own rigs (177, 2026-12-07) in the frame and solid the
 prediction reads them in, on the line through each joint parallel to y, in
-the run of the solid that holds it (1,123 of 1,227 joints; the others lie
-outside it, as inside a dress whose solid is its shell): 90 % lie between 0.42 and 0.66 of the way from
-front to back (5th to 95th percentiles: hips 0.41 to 0.55, shoulders 0.44 to
-0.58, hip joints 0.43 to 0.58, necks 0.45 to 0.69, heads 0.38 to 0.69). On
-bodies unlike the training ones the landmark network reads them far off
-that: on Quaternius' monsters the shoulders at a median 0.16 of the way back
-and the hip joints at 0.29 (the artists': 0.47 and 0.63; on their meshes'
-own crossings), some in front of the chest. Each such joint is moved along y only, into :data:`DEPTH_RANGE`
-of its run.
+the run of the solid that holds it (1,121 of 1,227 joints; the others lie
+outside it, as inside a dress whose solid is its shell): 90 % lie between
+0.41 and 0.67 of the way from front to back (5th to 95th percentiles: hips
+0.40 to 0.55, shoulders 0.43 to 0.59, hip joints 0.43 to 0.59, necks 0.44
+to 0.71, heads 0.36 to 0.69). On bodies unlike the training ones the
+landmark network reads them far off that: on Quaternius' monsters the
+shoulders at a median 0.16 of the way back and the hip joints at 0.29 (the
+artists': 0.47 and 0.63; on their meshes' own crossings), some in front of
+the chest. Each such landmark is moved along y only, into
+:data:`DEPTH_RANGE` of its run. The band holds the landmarks, not the
+finished skeleton: later steps move the shoulders onto the arms' axes and
+the head toward the neck (:mod:`.standard_skeleton`).
 """
 
 from __future__ import annotations
@@ -24,13 +27,13 @@ from .joint_features import SolidDepth
 #: The landmarks moved (:func:`trunk_joints_in_depth`). Elbows, wrists,
 #: knees and ankles are centred in their limb by :mod:`.limb_sections`.
 DEPTH_ROLES = ("hips", "neck", "head", "shoulder.L", "shoulder.R", "hip.L", "hip.R")
-#: Where between front (0) and back (1) of its run a joint may lie: a band
-#: about the middle, set from the training humanoids' rigs (the module
-#: docstring), not tuned. Clamped into it, their own joints move more than
-#: 0.02 of the largest side on 17 of 1,227 and more than 0.05 on 5 (the
-#: posed Nexuiz `lurk`'s and `nexus`'s shoulders and `lurk`'s hip joint, at
-#: 0.8 of the way back; the hips of Quaternius' mech `George`, in front of its
-#: body), 0.081 at most.
+#: Where between front (0) and back (1) of its run a joint may lie: a round
+#: band about the middle, not tuned, and narrower than the training rigs'
+#: spread for necks and heads (the module docstring); what justifies it is
+#: how little it moves those rigs' own joints: more than 0.02 of the largest
+#: side on 15 of 1,227 and more than 0.05 on 5 (the posed Nexuiz `lurk`'s
+#: and `nexus`'s shoulders and `lurk`'s hip joint, 0.8 of the way back; the
+#: hips of Quaternius' mech `George`, in front of its body), 0.082 at most.
 DEPTH_RANGE = (0.4, 0.6)
 
 
@@ -48,7 +51,7 @@ def trunk_joints_in_depth(points: dict, solid: SolidDepth) -> dict:
         if role not in points:
             continue
         at = np.asarray(points[role], dtype=np.float64)
-        run = _enclosing_run(solid_runs_along_y(solid, at), float(at[1]))
+        run = _run_to_move_into(solid_runs_along_y(solid, at), float(at[1]))
         if run is None:
             continue
         front, back = run
@@ -60,21 +63,24 @@ def trunk_joints_in_depth(points: dict, solid: SolidDepth) -> dict:
 
 def solid_runs_along_y(solid: SolidDepth, point: np.ndarray) -> list:
     """The (front, back) y intervals, front to back, where the line through
-    ``point`` parallel to y runs inside ``solid`` (at least half a cell
-    deep: inside, not in the interpolated fringe), to half a cell."""
+    ``point`` parallel to y runs inside ``solid``: from the centre of the
+    first cell inside (at least half a cell deep, not the interpolated
+    fringe) to the centre of the last. The solid marks every cell the
+    surface touches, so its outer faces lie up to a cell beyond the surface;
+    the centres lie within half a cell of it. Empty beside the body or off
+    the solid's grid."""
     count = solid.depth.shape[1]
     along = solid.origin[1] + (np.arange(count) + 0.5) * solid.cell_size
     line = np.column_stack([np.full(count, point[0]), along, np.full(count, point[2])])
     inside = np.concatenate([[False], solid.at(line) >= 0.5 * solid.cell_size, [False]])
     edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
-    half = 0.5 * solid.cell_size
-    return [(float(along[start] - half), float(along[end - 1] + half)) for start, end in zip(edges[::2], edges[1::2])]
+    return [(float(along[start]), float(along[end - 1])) for start, end in zip(edges[::2], edges[1::2])]
 
 
-def _enclosing_run(runs: list, y: float):
-    """The run of ``runs`` holding ``y``, the first when ``y`` is in front
-    of them all, the last when behind; None in a gap between runs or
-    without runs."""
+def _run_to_move_into(runs: list, y: float):
+    """The run of ``runs`` (front to back) holding ``y``, the first when
+    ``y`` is in front of them all, the last when behind; None in a gap
+    between runs or without runs."""
     if not runs:
         return None
     for run in runs:
