@@ -8,6 +8,7 @@ from autorig_addon.core.dataset.normalise import normalise
 from autorig_addon.core.errors import InputError
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
+from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.rigging.metarig import metarig_placement
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
 from autorig_addon.core.rigging.standard_skeleton import (
@@ -31,12 +32,14 @@ from autorig_addon.core.rigging.standard_skeleton import (
     limb_mirror_error,
     quadruped_skeleton,
     shoulders_on_arm_axes,
+    standard_skeleton,
     symmetrised,
     wrists_past_narrowest_forearm,
 )
+from autorig_addon.core.rigging.trunk_depth import DEPTH_RANGE, solid_runs_along_y
 from autorig_addon.core.skeleton.key_joints import key_joints
 from autorig_addon.core.skeleton.naming import mirror_name
-from autorig_addon.core.types import Skeleton
+from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh, procedural_biped_posed
 
 BIPED_BONES = {
@@ -144,6 +147,41 @@ def test_a_bipeds_hips_come_down_to_its_hip_joints_never_up():
     assert points["hips"][2] == 0.55  # the caller's landmarks are left as they were
     below = dict(points, hips=np.array([0.0, 0.01, 0.42]))
     np.testing.assert_array_equal(hips_at_most_at_hip_joints(below)["hips"], [0.0, 0.01, 0.42])
+
+
+def arms_forward_body():
+    """A box body facing -y whose arms are held out along x toward its front: the chest 0.2 deep (y -0.1 to 0.1),
+    the arms' axes at y -0.07, z 0.6; and its landmarks, the neck read 0.3 in front of it."""
+    boxes = [([-0.1, -0.1, 0.3], [0.1, 0.1, 0.75]), ([-0.06, -0.06, 0.75], [0.06, 0.06, 0.9]),
+             ([0.1, -0.1, 0.57], [0.6, -0.04, 0.63]), ([-0.6, -0.1, 0.57], [-0.1, -0.04, 0.63]),
+             ([0.03, -0.03, 0.0], [0.09, 0.03, 0.3]), ([-0.09, -0.03, 0.0], [-0.03, 0.03, 0.3])]
+    mesh = Mesh.concatenate([box_mesh(low, high, 0.02) for low, high in boxes])
+    points = {"hips": [0.0, 0.0, 0.3], "neck": [0.0, -0.3, 0.74], "head": [0.0, 0.0, 0.78]}
+    for side, sign in ((".L", 1.0), (".R", -1.0)):
+        points.update({"shoulder" + side: [sign * 0.08, 0.0, 0.6], "elbow" + side: [sign * 0.3, -0.07, 0.6],
+                       "wrist" + side: [sign * 0.5, -0.07, 0.6], "hip" + side: [sign * 0.06, 0.0, 0.3],
+                       "knee" + side: [sign * 0.06, 0.0, 0.15], "ankle" + side: [sign * 0.06, 0.0, 0.02]})
+    return mesh, Landmarks({role: np.array(point) for role, point in points.items()},
+                           {"biped": 1.0, "quadruped": 0.0, "other": 0.0})
+
+
+def test_a_bipeds_trunk_joints_end_between_its_front_and_back_shoulders_too():
+    """standard_skeleton holds the trunk joints in the depth band of the solid (trunk_depth), the shoulders again once
+    they are put on the arms' axes, which run in front of the chest's middle here."""
+    mesh, landmarks = arms_forward_body()
+    solid = solid_depth(mesh)
+    skeleton = standard_skeleton(landmarks, BIPED, mesh.vertices, True, mesh, solid=solid)
+    found = key_joints(skeleton.names, skeleton.joints).positions
+    low, high = DEPTH_RANGE
+    for role in ("neck", "shoulder.L", "shoulder.R"):
+        (front, back), = [run for run in solid_runs_along_y(solid, found[role]) if run[0] <= found[role][1] <= run[1]]
+        assert low - 1e-9 <= (found[role][1] - front) / (back - front) <= high + 1e-9, role
+    # Without the solid the neck stays in front of the body, and the shoulders, put on the arms' axes, in front of
+    # the band (a quarter of the way back).
+    unheld = standard_skeleton(landmarks, BIPED, mesh.vertices, True, mesh)
+    unheld = key_joints(unheld.names, unheld.joints).positions
+    assert unheld["neck"][1] == pytest.approx(-0.3)
+    assert (unheld["shoulder.L"][1] + 0.1) / 0.2 < low - 0.1
 
 
 def test_a_bipeds_hip_joints_come_in_over_its_knees_never_out():

@@ -64,7 +64,6 @@ from .standard_skeleton import (
 )
 from .symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from .tree_features import candidate_pairs, pair_features, root_features
-from .trunk_depth import trunk_joints_in_depth
 from .typical_proportions import (
     TYPICAL_CROTCH_SHARE,
     TYPICAL_NECK_SHARE,
@@ -277,8 +276,6 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
     landmarks = _raise_hip_joints_to_crotch(Mesh(graph.vertices, proxy.triangles), solid, landmarks)
-    if sure_standard_kind(landmarks) == BIPED:
-        landmarks = replace(landmarks, points=trunk_joints_in_depth(landmarks.points, solid))
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     near = landmarks.closest_rig or nearest
@@ -598,7 +595,7 @@ def skeleton_from_votes(votes: JointVotes, *, bandwidth: float = DEFAULT_BANDWID
     if kind != FREE_FORM:
         nearly_symmetric = symmetry and mirror_error(votes.proxy_vertices, 0) <= NEAR_SYMMETRIC_ERROR
         skeleton = standard_skeleton(votes.landmarks, kind, votes.proxy_vertices, nearly_symmetric, votes.surface,
-                                     fingers)
+                                     fingers, votes.solid)
         return Skeleton(apply_transform(skeleton.joints, to_mesh), skeleton.parents,
                         preset_names(skeleton.names, names)[0], apply_transform(skeleton.tails, to_mesh))
     if not MIN_BANDWIDTH <= bandwidth <= MAX_BANDWIDTH:

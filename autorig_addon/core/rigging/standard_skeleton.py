@@ -48,11 +48,12 @@ from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
-from .joint_features import JointGraph
+from .joint_features import JointGraph, SolidDepth
 from .limb_sections import limb_joints_centred
 from .networks import landmarks as landmark_network
 from .networks.landmarks import BODY_KINDS, LANDMARKS, STANDARD_KINDS
 from .rig_library import ClosestRig, KnownRelative
+from .trunk_depth import trunk_joints_in_depth
 
 BIPED, QUADRUPED, OTHER = BODY_KINDS
 #: Template choices: the network's guess, one kind forced, or the free-form skeleton.
@@ -633,20 +634,28 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
 
 
 def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool,
-                      surface: Mesh | None = None, fingers: bool = False) -> Skeleton:
+                      surface: Mesh | None = None, fingers: bool = False, solid: SolidDepth | None = None) -> Skeleton:
     """The standard skeleton of ``kind`` (biped or quadruped) around the
     landmarks, in the normalised frame. A biped's limbs are read on
     ``surface`` (the full-resolution mesh, normalised; the proxy's
     ``vertices`` alone without it), whether or not it gets ``fingers``: it
     gets them when asked and both hands have separable ones
-    (:func:`both_hands_fingers`)."""
+    (:func:`both_hands_fingers`); its trunk joints are held between its
+    front and back in ``solid`` (the proxy's, :mod:`.trunk_depth`) when
+    given."""
     points = symmetrised(landmarks.points_for(kind), symmetric_shape, vertices)
     if kind == BIPED and landmarks.copied_for(kind) is None:
         # These correct where the network puts a biped's joints; an artist's rig copied whole is left as it is.
+        if solid is not None:
+            points = trunk_joints_in_depth(points, solid)
         points = head_near_neck(hips_at_most_at_hip_joints(points))
         # Each limb is read on its own side; a symmetric shape's limbs stay mirror images.
         arms_from = vertices if surface is None else surface.vertices
-        points = wrists_past_narrowest_forearm(shoulders_on_arm_axes(points, vertices), arms_from)
+        points = shoulders_on_arm_axes(points, vertices)
+        if solid is not None:
+            # The arm's axis may lie in front of the trunk's middle (arms held forward): the band holds there too.
+            points = trunk_joints_in_depth(points, solid, ("shoulder" + LEFT, "shoulder" + RIGHT))
+        points = wrists_past_narrowest_forearm(points, arms_from)
         if surface is not None:
             points = limb_joints_centred(points, surface)
         points = symmetrised(hip_joints_over_knees(points), symmetric_shape, vertices)

@@ -13,9 +13,9 @@ landmark network reads them far off that: on Quaternius' monsters the
 shoulders at a median 0.16 of the way back and the hip joints at 0.29 (the
 artists': 0.47 and 0.63; on their meshes' own crossings), some in front of
 the chest. Each such landmark is moved along y only, into
-:data:`DEPTH_RANGE` of its run. The band holds the landmarks, not the
-finished skeleton: later steps move the shoulders onto the arms' axes and
-the head toward the neck (:mod:`.standard_skeleton`).
+:data:`DEPTH_RANGE` of its run (:func:`.standard_skeleton.standard_skeleton`
+does it first, and again for the shoulders once they are put on the arms'
+axes, which may lie in front of the trunk's middle).
 """
 
 from __future__ import annotations
@@ -37,9 +37,9 @@ DEPTH_ROLES = ("hips", "neck", "head", "shoulder.L", "shoulder.R", "hip.L", "hip
 DEPTH_RANGE = (0.4, 0.6)
 
 
-def trunk_joints_in_depth(points: dict, solid: SolidDepth) -> dict:
+def trunk_joints_in_depth(points: dict, solid: SolidDepth, roles: tuple = DEPTH_ROLES) -> dict:
     """A biped's landmarks (``points``, by role, normalised frame: facing
-    -y) with each joint of :data:`DEPTH_ROLES` moved along y into
+    -y) with each joint of ``roles`` (of :data:`DEPTH_ROLES`) moved along y into
     :data:`DEPTH_RANGE` of the run of ``solid`` it lies in. A joint in
     front of the body or behind it takes the nearest run; one in a gap
     between runs keeps its place: it may lie inside a hollow garment (a
@@ -47,7 +47,7 @@ def trunk_joints_in_depth(points: dict, solid: SolidDepth) -> dict:
     whose solid leaked."""
     points = dict(points)
     low, high = DEPTH_RANGE
-    for role in DEPTH_ROLES:
+    for role in roles:
         if role not in points:
             continue
         at = np.asarray(points[role], dtype=np.float64)
