@@ -90,6 +90,12 @@ class SolidDepth:
         coordinates = ((np.asarray(points, dtype=np.float64).reshape(-1, 3) - self.origin) / self.cell_size - 0.5).T
         return ndimage.map_coordinates(self.depth, coordinates, order=1, mode="constant", cval=0.0)
 
+    @property
+    def inside_depth(self) -> float:
+        """The depth (:meth:`at`) from which a point is inside the solid:
+        half a cell, so the fringe the interpolation spreads around it is not."""
+        return 0.5 * self.cell_size
+
 
 def solid_depth(mesh: Mesh, resolution: int = DEPTH_RESOLUTION) -> SolidDepth:
     """The :class:`SolidDepth` of a mesh (units of ``mesh``)."""

@@ -221,8 +221,9 @@ def hips_at_most_at_hip_joints(points: dict) -> dict:
 def hip_joints_over_knees(points: dict) -> dict:
     """A biped's landmarks with each hip joint drawn across toward the
     midline (the middle of the two hip joints), x only, until it lies no
-    farther from it than its knee: a thigh does not splay outward going up. Artists' never do by more
-    than 0.0075 of the largest side (the 177 training humanoids' 354 hip
+    farther from it than its knee: a thigh does not splay outward going up.
+    Artists' never do by more than 0.0075 of the largest side (the 177
+    training humanoids' 354 hip
     joints, from the middle of the two: a median 0.78 of their knee's
     distance; SuperTuxKart's beach woman's right one the widest); on
     short-legged bodies unlike the training ones the network put the hip

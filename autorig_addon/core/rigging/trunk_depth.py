@@ -63,16 +63,15 @@ def trunk_joints_in_depth(points: dict, solid: SolidDepth, roles: tuple = DEPTH_
 
 def solid_runs_along_y(solid: SolidDepth, point: np.ndarray) -> list:
     """The (front, back) y intervals, front to back, where the line through
-    ``point`` parallel to y runs inside ``solid``: from the centre of the
-    first cell inside (at least half a cell deep, not the interpolated
-    fringe) to the centre of the last. The solid marks every cell the
+    ``point`` parallel to y runs inside ``solid`` (:attr:`.SolidDepth.inside_depth`
+    deep): from the centre of the first cell inside to the centre of the last. The solid marks every cell the
     surface touches, so its outer faces lie up to a cell beyond the surface;
     the centres lie within half a cell of it. Empty beside the body or off
     the solid's grid."""
     count = solid.depth.shape[1]
     along = solid.origin[1] + (np.arange(count) + 0.5) * solid.cell_size
     line = np.column_stack([np.full(count, point[0]), along, np.full(count, point[2])])
-    inside = np.concatenate([[False], solid.at(line) >= 0.5 * solid.cell_size, [False]])
+    inside = np.concatenate([[False], solid.at(line) >= solid.inside_depth, [False]])
     edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
     return [(float(along[start]), float(along[end - 1])) for start, end in zip(edges[::2], edges[1::2])]
 

@@ -102,8 +102,7 @@ def crotch_height(solid: SolidDepth, knees: np.ndarray, top: float, enclosed=Non
         return None
     line = np.column_stack([np.zeros_like(heights), np.full_like(heights, middle[1]), heights])
     depth = solid.at(line)
-    # Half a cell deep: inside the solid, not in the interpolated fringe around it.
-    inside = depth >= 0.5 * solid.cell_size
+    inside = depth >= solid.inside_depth
     first = int(np.argmax(inside)) if inside.any() else len(heights)
     if enclosed is not None and first > 0:
         # Only the points below the solid's first one can come first; the winding number costs per point.
