@@ -40,6 +40,7 @@ from ..progress import ProgressCallback, report
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
+from .body_layout import BipedLayout, biped_layout
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
 from .facing import TOE_REACH_SURE, facing, from_behind, front_untold_note, half_turned, toe_reach
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
@@ -256,8 +257,10 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
     nearest = None if sure_standard_kind(landmarks) else nearest_known_body(normalised_surface)
     relative = _of_relative_kind(nearest)
-    if way.front_untold and relative is not None:
-        # Read as neither kind either way round, the body is a biped by its nearest known body: its toes tell its front.
+    layout = _layout_of_untold_kind(landmarks, relative, solid)
+    if way.front_untold and (relative or layout) is not None:
+        # Read as neither kind either way round, the body is a biped by its nearest known body or its layout: its
+        # toes tell its front.
         toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
         if toes is not None and toes < -TOE_REACH_SURE:
             rotation = HALF_TURN @ rotation
@@ -265,13 +268,13 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
             nearest = nearest_known_body(normalised_surface)
             relative = _of_relative_kind(nearest)
+            layout = _layout_of_untold_kind(landmarks, relative, solid)
             notes.append(_turned_note("its toes point toward +Y"))
         elif toes is None or toes <= TOE_REACH_SURE:
             notes.append(front_untold_note(axis_name(-rotation[1]), biped=True))
     elif way.front_untold:
         notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
-    if relative is not None:
-        landmarks = replace(landmarks, relative=relative)
+    landmarks = replace(landmarks, relative=relative, layout=layout)
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
     notes += proportion_notes
@@ -302,6 +305,16 @@ def _of_relative_kind(nearest: KnownRelative | None) -> KnownRelative | None:
     return nearest if nearest is not None and nearest.kind in RELATIVE_KINDS else None
 
 
+def _layout_of_untold_kind(landmarks: Landmarks, relative: KnownRelative | None,
+                           solid: SolidDepth) -> BipedLayout | None:
+    """The layout of a body's biped landmarks (:func:`.body_layout.biped_layout`)
+    when neither the landmark network nor a known ``relative`` tells its
+    kind; else None."""
+    if landmarks.read_surely or relative is not None:
+        return None
+    return biped_layout(landmarks.points, solid)
+
+
 def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks,
                                        read_from_behind: bool = False) -> tuple[Landmarks, tuple]:
     """A biped's landmarks read again on its body (``normalised``: the proxy
@@ -322,7 +335,7 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
     body, stretch = stretched(normalised, found.height_map)
     graph = joint_graph(body)
     reread = from_behind(predict_landmarks(half_turned(graph))) if read_from_behind else predict_landmarks(graph)
-    reread = replace(reread, relative=landmarks.relative)
+    reread = replace(reread, relative=landmarks.relative, layout=landmarks.layout)
     if reread.standard_kind != BIPED:
         return landmarks, ()  # read again, the body is no sure biped: the first reading stands
     if found.big_head:
@@ -502,8 +515,8 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
         return guess, f"Template: standard {guess} skeleton; {seen}."
     kind = sure_standard_kind(votes.landmarks)
     if kind is not None:
-        return kind, (f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; "
-                      f"{votes.landmarks.relative.note}.")
+        told_by = votes.landmarks.relative or votes.landmarks.layout
+        return kind, f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; {told_by.note}."
     return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
                        "force one.")
 

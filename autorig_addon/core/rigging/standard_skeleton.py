@@ -47,6 +47,7 @@ from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
+from .body_layout import BipedLayout
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import JointGraph, SolidDepth
 from .limb_sections import limb_joints_centred
@@ -94,12 +95,15 @@ class Landmarks:
         stand in for the network's (:mod:`.rig_library`); None when none lies near
     relative : KnownRelative, the nearest known body when it tells the kind the
         network does not read surely (:func:`.rig_library.nearest_known_body`); else None
+    layout : BipedLayout, the body's biped landmarks laid out as a biped's when
+        neither the network nor a known body tells the kind (:func:`.body_layout.biped_layout`); else None
     """
 
     points: dict
     kind_probabilities: dict
     closest_rig: ClosestRig | None = None
     relative: KnownRelative | None = None
+    layout: BipedLayout | None = None
 
     @property
     def kind(self) -> str:
@@ -119,10 +123,11 @@ class Landmarks:
     def standard_kind(self) -> str | None:
         """The kind of standard skeleton the body gets by default: the
         network's, when it reads one surely (:attr:`read_surely`); else its
-        known relative's; else None."""
+        known relative's; else a biped when its :attr:`layout` is one; else None."""
         if self.read_surely:
             return self.kind
-        return self.relative.kind if self.relative is not None else None
+        told_by = self.relative or self.layout
+        return told_by.kind if told_by is not None else None
 
     def copied_for(self, kind: str) -> ClosestRig | None:
         """The known rig whose key joints a standard skeleton of ``kind`` takes:

@@ -1,0 +1,137 @@
+"""A body laid out as a biped (autorig_addon.core.rigging.body_layout), on
+blocky bodies built from boxes with the joints where an artist puts them."""
+
+import numpy as np
+import pytest
+
+from autorig_addon.core.rigging.body_layout import MIN_INSIDE_SHARE, SEGMENT_SAMPLES, biped_layout
+from autorig_addon.core.rigging.joint_features import solid_depth
+from autorig_addon.core.types import Mesh
+from geometry_fixtures import box_mesh
+
+SPACING = 0.05
+
+
+def _boxes(*corners) -> Mesh:
+    return Mesh.concatenate([box_mesh(low, high, SPACING) for low, high in corners])
+
+
+#: A chibi of boxes facing -y, 1 tall: legs 0.25 (apart by 0.1), trunk 0.3, a head 0.45 as wide as it is tall,
+#: arms held out to the sides (a T-pose).
+LEGS = (([-0.2, -0.08, 0.0], [-0.05, 0.08, 0.25]), ([0.05, -0.08, 0.0], [0.2, 0.08, 0.25]))
+TRUNK = ([-0.2, -0.1, 0.25], [0.2, 0.1, 0.55])
+HEAD = ([-0.25, -0.2, 0.55], [0.25, 0.2, 1.0])
+ARMS = (([-0.5, -0.06, 0.42], [-0.2, 0.06, 0.52]), ([0.2, -0.06, 0.42], [0.5, 0.06, 0.52]))
+#: Its joints, where an artist puts them.
+CHIBI_JOINTS = {
+    "hips": [0.0, 0.0, 0.28], "neck": [0.0, 0.0, 0.54], "head": [0.0, 0.0, 0.6],
+    "shoulder.L": [0.22, 0.0, 0.47], "elbow.L": [0.33, 0.0, 0.47], "wrist.L": [0.44, 0.0, 0.47],
+    "hip.L": [0.12, 0.0, 0.26], "knee.L": [0.12, 0.0, 0.13], "ankle.L": [0.12, 0.0, 0.03],
+}
+
+
+def _both_sides(points: dict) -> dict:
+    points = {name: np.array(point, dtype=np.float64) for name, point in points.items()}
+    for name in [name for name in points if name.endswith(".L")]:
+        points[name[:-2] + ".R"] = points[name] * np.array([-1.0, 1.0, 1.0])
+    return points
+
+
+@pytest.fixture(scope="module")
+def chibi():
+    return solid_depth(_boxes(*LEGS, TRUNK, HEAD, *ARMS))
+
+
+def test_a_blocky_chibi_with_its_joints_in_place_is_laid_out_as_a_biped(chibi):
+    layout = biped_layout(_both_sides(CHIBI_JOINTS), chibi)
+    assert layout is not None and layout.kind == "biped"
+    assert layout.inside_share == 1.0
+    assert layout.note == ("its biped landmarks make an upright body (every limb and the trunk inside it, the legs "
+                           "apart, the head on top), so it is taken for a biped")
+
+
+def test_legs_in_one_column_are_no_pair_of_legs():
+    # The same body standing on one block as wide as both legs: between the knees is inside.
+    column = ([-0.2, -0.08, 0.0], [0.2, 0.08, 0.25])
+    solid = solid_depth(_boxes(column, TRUNK, HEAD, *ARMS))
+    assert biped_layout(_both_sides(CHIBI_JOINTS), solid) is None
+
+
+def test_a_limb_mostly_outside_the_body_breaks_the_layout(chibi):
+    # The wrists read far past the hands: the forearms leave the body after a third of their length.
+    points = _both_sides({**CHIBI_JOINTS, "wrist.L": [0.7, 0.0, 0.47]})
+    assert biped_layout(points, chibi) is None
+    # Read just past the hands, the forearm is still mostly inside (its end allowed out).
+    points = _both_sides({**CHIBI_JOINTS, "wrist.L": [0.52, 0.0, 0.47]})
+    layout = biped_layout(points, chibi)
+    assert MIN_INSIDE_SHARE <= layout.inside_share < 1.0
+    assert layout.inside_share == pytest.approx(round(layout.inside_share * SEGMENT_SAMPLES) / SEGMENT_SAMPLES)
+    assert f"every limb and the trunk at least {layout.inside_share:.0%} inside it" in layout.note
+
+
+def test_joints_out_of_their_top_to_bottom_order_are_no_biped(chibi):
+    # The head read below the neck, or a knee below an ankle.
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "head": [0.0, 0.0, 0.5]}), chibi) is None
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "knee.L": [0.12, 0.0, 0.02]}), chibi) is None
+
+
+def test_a_quadrupeds_trunk_lies_along_its_length():
+    # A four-legged box animal facing -y, with the biped landmarks a network gives it: the hips at its rump, the
+    # neck and head at its front, a leg pair each for the "arms" and "legs". Legs apart, all inside, in order from
+    # the top: only the trunk's run along y tells it is no biped.
+    legs = [([x0, y0, 0.0], [x0 + 0.1, y0 + 0.1, 0.3]) for x0 in (-0.15, 0.05) for y0 in (-0.4, 0.3)]
+    body = ([-0.15, -0.45, 0.3], [0.15, 0.45, 0.55])
+    head = ([-0.1, -0.6, 0.45], [0.1, -0.4, 0.7])
+    solid = solid_depth(_boxes(*legs, body, head))
+    points = _both_sides({
+        "hips": [0.0, 0.35, 0.42], "neck": [0.0, -0.4, 0.5], "head": [0.0, -0.5, 0.6],
+        "shoulder.L": [0.1, -0.35, 0.4], "elbow.L": [0.1, -0.35, 0.32], "wrist.L": [0.1, -0.35, 0.2],
+        "hip.L": [0.1, 0.35, 0.4], "knee.L": [0.1, 0.35, 0.2], "ankle.L": [0.1, 0.35, 0.05],
+    })
+    assert biped_layout(points, solid) is None
+    # Stood up on its hind legs (the same landmarks with the neck above the hips) it would pass the trunk test: the
+    # other tests are what they are, and the trunk is what failed.
+    upright = dict(points, hips=np.array([0.0, 0.35, 0.35]), neck=np.array([0.0, 0.33, 0.5]),
+                   head=np.array([0.0, 0.33, 0.52]))
+    assert biped_layout(upright, solid) is not None
+
+
+def test_a_body_read_as_other_with_no_known_relative_is_a_biped_by_its_layout(monkeypatch):
+    from dataclasses import replace
+
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+
+    mesh = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
+    low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    network = predict.predict_landmarks
+
+    def read_as_other(graph):
+        # The network's kind head reads "other", as it reads Kenney's minis; its points are the chibi's joints (in
+        # the frame the graph is in: its box is the mesh's, scaled and moved).
+        found = network(graph)
+        box_low, box_high = graph.vertices.min(axis=0), graph.vertices.max(axis=0)
+        points = {name: box_low + (point - low) / (high - low) * (box_high - box_low)
+                  for name, point in _both_sides(CHIBI_JOINTS).items()}
+        return replace(found, points={**found.points, **points},
+                       kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9})
+
+    monkeypatch.setattr(predict, "predict_landmarks", read_as_other)
+    monkeypatch.setattr(predict, "nearest_known_body", lambda surface: None)  # no known body near it
+    votes = predict.predict_votes(mesh)
+    assert votes.landmarks.relative is None and votes.landmarks.layout is not None
+    kind, note = predict.chosen_template(votes, known_rig=False)
+    assert kind == "biped"
+    assert note.startswith("Template: standard biped skeleton; the landmark network reads the body as other (90% "
+                           "sure), not surely a biped or quadruped; its biped landmarks make an upright body")
+    skeleton = predict.skeleton_from_votes(votes, fingers=False, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    assert len(found) == 15
+    # In the mesh's own space: the left shoulder on the body's left (+x, facing -y), the head above the neck above
+    # the hips, the ankles at the feet.
+    assert found["shoulder.L"][0] > 0.15 and found["shoulder.R"][0] < -0.15
+    assert found["head"][2] > found["neck"][2] > found["hips"][2] > 0.25
+    assert found["ankle.L"][2] < 0.1 and found["ankle.R"][2] < 0.1
+    # Were its landmarks laid out otherwise (no layout found), nothing would tell its kind: the free-form skeleton.
+    monkeypatch.setattr(predict, "biped_layout", lambda points, solid: None)
+    assert predict.chosen_template(predict.predict_votes(mesh))[0] == "free-form"
