@@ -4,7 +4,7 @@ blocky bodies built from boxes with the joints where an artist puts them."""
 import numpy as np
 import pytest
 
-from autorig_addon.core.rigging.body_layout import MIN_INSIDE_SHARE, SEGMENT_SAMPLES, biped_layout
+from autorig_addon.core.rigging.body_layout import MIN_INSIDE_SHARE, MIN_TRUNK_RISE, SEGMENT_SAMPLES, biped_layout
 from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh
@@ -46,8 +46,8 @@ def test_a_blocky_chibi_with_its_joints_in_place_is_laid_out_as_a_biped(chibi):
     layout = biped_layout(_both_sides(CHIBI_JOINTS), chibi)
     assert layout is not None and layout.kind == "biped"
     assert layout.inside_share == 1.0
-    assert layout.note == ("its biped landmarks make an upright body (every limb and the trunk inside it, the legs "
-                           "apart, the head on top), so it is taken for a biped")
+    assert layout.note == ("its biped landmarks make an upright body (every limb, the trunk and the neck inside it, "
+                           "the legs apart, the head on top), so it is taken for a biped")
 
 
 def test_legs_in_one_column_are_no_pair_of_legs():
@@ -66,13 +66,29 @@ def test_a_limb_mostly_outside_the_body_breaks_the_layout(chibi):
     layout = biped_layout(points, chibi)
     assert MIN_INSIDE_SHARE <= layout.inside_share < 1.0
     assert layout.inside_share == pytest.approx(round(layout.inside_share * SEGMENT_SAMPLES) / SEGMENT_SAMPLES)
-    assert f"every limb and the trunk at least {layout.inside_share:.0%} inside it" in layout.note
+    assert f"every limb, the trunk and the neck at least {layout.inside_share:.0%} inside it" in layout.note
+    # The arm's box ends at x = 0.5: a wrist at 0.59 leaves 7 of the forearm's 11 points inside (0.64, enough), one at
+    # 0.64 leaves 6 (0.55, too few).
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "wrist.L": [0.59, 0.0, 0.47]}), chibi).inside_share == \
+        pytest.approx(7 / 11)
+    assert 6 / 11 < MIN_INSIDE_SHARE < 7 / 11
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "wrist.L": [0.64, 0.0, 0.47]}), chibi) is None
 
 
 def test_joints_out_of_their_top_to_bottom_order_are_no_biped(chibi):
     # The head read below the neck, or a knee below an ankle.
     assert biped_layout(_both_sides({**CHIBI_JOINTS, "head": [0.0, 0.0, 0.5]}), chibi) is None
     assert biped_layout(_both_sides({**CHIBI_JOINTS, "knee.L": [0.12, 0.0, 0.02]}), chibi) is None
+
+
+def test_a_trunk_leaning_more_than_it_rises_over_two_is_no_upright_biped():
+    # A chibi with a trunk as deep as its head, its neck read forward of its hips: rising 0.26, the trunk may run
+    # 0.13 along y at most.
+    deep_trunk = ([-0.2, -0.2, 0.25], [0.2, 0.2, 0.55])
+    solid = solid_depth(_boxes(*LEGS, deep_trunk, HEAD, *ARMS))
+    assert MIN_TRUNK_RISE == 2.0
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "neck": [0.0, -0.1, 0.54]}), solid) is not None
+    assert biped_layout(_both_sides({**CHIBI_JOINTS, "neck": [0.0, -0.16, 0.54]}), solid) is None
 
 
 def test_a_quadrupeds_trunk_lies_along_its_length():
@@ -96,30 +112,42 @@ def test_a_quadrupeds_trunk_lies_along_its_length():
     assert biped_layout(upright, solid) is not None
 
 
-def test_a_body_read_as_other_with_no_known_relative_is_a_biped_by_its_layout(monkeypatch):
+OTHER_SURELY = {"biped": 0.05, "quadruped": 0.05, "other": 0.9}
+
+
+def _votes(monkeypatch, mesh, kind_probabilities, nearest=None):
+    """predict_votes on ``mesh`` with the landmark network's kind head reading
+    ``kind_probabilities`` (as it reads Kenney's minis: "other") and its points
+    the chibi's joints, in the frame the graph is in (its box is the chibi's
+    box, scaled and moved), and ``nearest`` as the nearest known body."""
     from dataclasses import replace
 
     from autorig_addon.core.rigging import predict
-    from autorig_addon.core.skeleton.key_joints import key_joints
 
-    mesh = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
-    low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    chibi = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
+    low, high = chibi.vertices.min(axis=0), chibi.vertices.max(axis=0)
     network = predict.predict_landmarks
 
-    def read_as_other(graph):
-        # The network's kind head reads "other", as it reads Kenney's minis; its points are the chibi's joints (in
-        # the frame the graph is in: its box is the mesh's, scaled and moved).
+    def read(graph):
         found = network(graph)
         box_low, box_high = graph.vertices.min(axis=0), graph.vertices.max(axis=0)
         points = {name: box_low + (point - low) / (high - low) * (box_high - box_low)
                   for name, point in _both_sides(CHIBI_JOINTS).items()}
-        return replace(found, points={**found.points, **points},
-                       kind_probabilities={"biped": 0.05, "quadruped": 0.05, "other": 0.9})
+        return replace(found, points={**found.points, **points}, kind_probabilities=kind_probabilities)
 
-    monkeypatch.setattr(predict, "predict_landmarks", read_as_other)
-    monkeypatch.setattr(predict, "nearest_known_body", lambda surface: None)  # no known body near it
-    votes = predict.predict_votes(mesh)
+    monkeypatch.setattr(predict, "predict_landmarks", read)
+    monkeypatch.setattr(predict, "nearest_known_body", lambda surface: nearest)
+    return predict.predict_votes(mesh)
+
+
+def test_a_body_read_as_other_with_no_known_relative_is_a_biped_by_its_layout(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+
+    mesh = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
+    votes = _votes(monkeypatch, mesh, OTHER_SURELY)
     assert votes.landmarks.relative is None and votes.landmarks.layout is not None
+    assert votes.landmarks.kind_told_by is votes.landmarks.layout
     kind, note = predict.chosen_template(votes, known_rig=False)
     assert kind == "biped"
     assert note.startswith("Template: standard biped skeleton; the landmark network reads the body as other (90% "
@@ -135,3 +163,34 @@ def test_a_body_read_as_other_with_no_known_relative_is_a_biped_by_its_layout(mo
     # Were its landmarks laid out otherwise (no layout found), nothing would tell its kind: the free-form skeleton.
     monkeypatch.setattr(predict, "biped_layout", lambda points, solid: None)
     assert predict.chosen_template(predict.predict_votes(mesh))[0] == "free-form"
+
+
+def test_the_layout_is_read_only_when_neither_the_network_nor_a_known_biped_tells_the_kind(monkeypatch):
+    from autorig_addon.core.rigging.rig_library import KnownRelative
+
+    mesh = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
+    # Read surely as a biped: nothing else is asked.
+    surely = _votes(monkeypatch, mesh, {"biped": 0.9, "quadruped": 0.05, "other": 0.05}).landmarks
+    assert surely.layout is None and surely.kind_told_by is None and surely.standard_kind == "biped"
+    # Near a known biped: the relative tells it, and the layout is not read.
+    relative = KnownRelative("kaykit/Ranger", "biped", 0.03)
+    near = _votes(monkeypatch, mesh, OTHER_SURELY, nearest=relative).landmarks
+    assert near.layout is None and near.kind_told_by == relative
+
+
+def test_a_body_a_biped_by_its_layout_facing_plus_y_is_turned_by_its_toes(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+
+    # The chibi with feet reaching forward of its legs (toes), given facing +Y: turned half a turn.
+    feet = [([x0, -0.2, 0.0], [x0 + 0.15, 0.08, 0.05]) for x0 in (-0.2, 0.05)]
+    facing_minus_y = _boxes(*LEGS, *feet, TRUNK, HEAD, *ARMS)
+    mesh = type(facing_minus_y)(facing_minus_y.vertices * np.array([-1.0, -1.0, 1.0]), facing_minus_y.triangles)
+    votes = _votes(monkeypatch, mesh, OTHER_SURELY)
+    assert votes.landmarks.layout is not None
+    assert ("The character faces away from -Y (its toes point toward +Y); it was turned half a turn for the "
+            "prediction, so its .L bones lie on its own left.") in votes.notes
+    skeleton = predict.skeleton_from_votes(votes, fingers=False, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    # Facing +Y, its own left lies at -X.
+    assert found["shoulder.L"][0] < -0.15 and found["shoulder.R"][0] > 0.15

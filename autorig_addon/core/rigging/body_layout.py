@@ -1,8 +1,8 @@
-"""A body the landmark network reads as "other" that is laid out as a biped.
+"""A body the landmark network reads as no biped or quadruped surely that is laid out as a biped.
 
 The network's kind head knows the kinds of its training bodies. Kenney's
 blocky minis (a head half their height over two stubs of legs) are like
-none of them: it reads some as "other", up to 98 % sure, and no known body
+none of them: it reads some as "other", up to 98 % sure, and no known biped
 lies near enough to tell their kind (:func:`.rig_library.nearest_known_body`).
 Its biped landmarks on them still describe the body a person sees: four
 limbs and a trunk inside the solid, two legs apart, a head on top. This
@@ -15,7 +15,8 @@ the one number, :data:`MIN_INSIDE_SHARE`, was checked on the training
 characters (2026-12-07, each read with itself and its near-duplicates left
 out of the rig library): no training fish, bird, quadruped or other body
 passes (their best: Quaternius' mechs, legs apart and upright, with a limb
-0.36 inside; the quadrupeds' trunks lie along y), while 122 of the 177
+0.36 inside; 26 of the 51 quadrupeds pass all but the trunk, which lies
+along y), while 122 of the 177
 training humanoids do (the others fail on a limb mostly outside, a wrist
 read past the fingertips: the test is strict, since a false biped is worse
 than a free-form skeleton).
@@ -24,10 +25,14 @@ than a free-form skeleton).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from .joint_features import SolidDepth
+from .networks.landmarks import BODY_KINDS
+
+BIPED = BODY_KINDS[0]
 
 #: The segments between landmarks that lie inside an upright biped's solid:
 #: each arm's and leg's two bones, the trunk and the neck.
@@ -55,13 +60,13 @@ class BipedLayout:
     """
 
     inside_share: float
-    kind = "biped"
+    kind: ClassVar[str] = BIPED
 
     @property
     def note(self) -> str:
         inside = "inside it" if self.inside_share >= 1.0 else f"at least {self.inside_share:.0%} inside it"
-        return (f"its biped landmarks make an upright body (every limb and the trunk {inside}, the legs apart, the "
-                "head on top), so it is taken for a biped")
+        return (f"its biped landmarks make an upright body (every limb, the trunk and the neck {inside}, the legs "
+                "apart, the head on top), so it is taken for a biped")
 
 
 def biped_layout(points: dict, solid: SolidDepth) -> BipedLayout | None:

@@ -258,7 +258,7 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     nearest = None if sure_standard_kind(landmarks) else nearest_known_body(normalised_surface)
     relative = _of_relative_kind(nearest)
     layout = _layout_of_untold_kind(landmarks, relative, solid)
-    if way.front_untold and (relative or layout) is not None:
+    if way.front_untold and (relative is not None or layout is not None):
         # Read as neither kind either way round, the body is a biped by its nearest known body or its layout: its
         # toes tell its front.
         toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
@@ -308,8 +308,9 @@ def _of_relative_kind(nearest: KnownRelative | None) -> KnownRelative | None:
 def _layout_of_untold_kind(landmarks: Landmarks, relative: KnownRelative | None,
                            solid: SolidDepth) -> BipedLayout | None:
     """The layout of a body's biped landmarks (:func:`.body_layout.biped_layout`)
-    when neither the landmark network nor a known ``relative`` tells its
-    kind; else None."""
+    when neither the landmark network (reading no kind surely) nor a known
+    ``relative`` (a biped near it, :func:`_of_relative_kind`) tells its kind;
+    else None."""
     if landmarks.read_surely or relative is not None:
         return None
     return biped_layout(landmarks.points, solid)
@@ -335,7 +336,10 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
     body, stretch = stretched(normalised, found.height_map)
     graph = joint_graph(body)
     reread = from_behind(predict_landmarks(half_turned(graph))) if read_from_behind else predict_landmarks(graph)
-    reread = replace(reread, relative=landmarks.relative, layout=landmarks.layout)
+    points = points_back(reread.points, stretch, found.height_map)
+    # A layout tells the kind of the points it was found on: the points read again must make one too.
+    layout = biped_layout(points, solid) if landmarks.layout is not None else None
+    reread = replace(reread, points=points, relative=landmarks.relative, layout=layout)
     if reread.standard_kind != BIPED:
         return landmarks, ()  # read again, the body is no sure biped: the first reading stands
     if found.big_head:
@@ -346,7 +350,7 @@ def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, land
         note = (f"The legs are short (crotch at {found.crotch / top:.0%} of the height) and were first read as "
                 f"longer: the landmarks were read again on the body stretched to a crotch at "
                 f"{TYPICAL_CROTCH_SHARE:.0%}.")
-    return replace(reread, points=points_back(reread.points, stretch, found.height_map)), (note,)
+    return reread, (note,)
 
 
 def _raise_hip_joints_to_crotch(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks) -> Landmarks:
@@ -367,7 +371,8 @@ def sure_standard_kind(landmarks: Landmarks) -> str | None:
     (:attr:`.standard_skeleton.Landmarks.standard_kind`): the kind the landmark
     network reads, when it is one with a standard skeleton read with at least
     :data:`.standard_skeleton.KIND_CONFIDENCE`, else its nearest known body's
-    (:data:`RELATIVE_KINDS`); else None."""
+    (:data:`RELATIVE_KINDS`), else a biped when its landmarks are laid out as
+    one (:func:`.body_layout.biped_layout`); else None."""
     return landmarks.standard_kind
 
 
@@ -498,7 +503,8 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
     else the landmark network's kind when it is a biped or a quadruped with
     probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`, else
     the kind of the body's nearest known body when it gave one
-    (:data:`RELATIVE_KINDS`).
+    (:data:`RELATIVE_KINDS`), else a biped when its landmarks are laid out
+    as one (:attr:`.standard_skeleton.Landmarks.layout`).
     """
     if template not in TEMPLATES:
         raise InputError(f"Unknown template '{template}': use one of {', '.join(TEMPLATES)}.")
@@ -515,8 +521,8 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
         return guess, f"Template: standard {guess} skeleton; {seen}."
     kind = sure_standard_kind(votes.landmarks)
     if kind is not None:
-        told_by = votes.landmarks.relative or votes.landmarks.layout
-        return kind, f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; {told_by.note}."
+        return kind, (f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; "
+                      f"{votes.landmarks.kind_told_by.note}.")
     return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
                        "force one.")
 

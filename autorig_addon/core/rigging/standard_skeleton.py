@@ -126,8 +126,16 @@ class Landmarks:
         known relative's; else a biped when its :attr:`layout` is one; else None."""
         if self.read_surely:
             return self.kind
-        told_by = self.relative or self.layout
-        return told_by.kind if told_by is not None else None
+        return self.kind_told_by.kind if self.kind_told_by is not None else None
+
+    @property
+    def kind_told_by(self) -> KnownRelative | BipedLayout | None:
+        """What tells the kind the network does not read surely: the known
+        :attr:`relative`, else the :attr:`layout`; None when neither does (or
+        the network reads it surely, which needs neither)."""
+        if self.read_surely:
+            return None
+        return self.relative if self.relative is not None else self.layout
 
     def copied_for(self, kind: str) -> ClosestRig | None:
         """The known rig whose key joints a standard skeleton of ``kind`` takes:
