@@ -597,3 +597,43 @@ def test_positive_definite_solve_agrees_with_a_complete_factorisation(monkeypatc
     assert np.all(solved[:, 7] == 0.0)
     residual = np.linalg.norm(system @ solved - rhs, axis=0)
     assert np.all(residual <= sparse_solve.RELATIVE_TOLERANCE * np.linalg.norm(rhs, axis=0))
+
+
+def test_a_target_lying_nine_tenths_on_one_bone_is_bound_wholly_to_it(body):
+    # A band around the upper bone reaching down into the blend (z 0.55 to 0.95; 'upper' rises from 0.4 to 0.6):
+    # its lowest rows carry some 'lower', a tenth of its weight at most.
+    source, weights = body
+    band = sleeve(z0=0.55, height=0.4, rings=9)
+    blended = transfer_weights(source, weights, band, TransferOptions(rigid_accessory=False))
+    lower = blended.weights.matrix[:, 0]
+    assert lower.max() > 0.1 and blended.rigid_bone == ""
+    result = transfer_weights(source, weights, band)
+    np.testing.assert_array_equal(result.weights.matrix, [[0.0, 1.0]] * band.vertex_count)
+    assert result.rigid_bone == "upper"
+    assert result.summary().endswith("bound wholly to bone 'upper' (a rigid accessory: nine tenths or more of its "
+                                     "weight lay there)")
+    # Protected rows keep their own weights; the rest is bound.
+    bottom = band.vertices[:, 2] < 0.6
+    kept = Weights(np.column_stack([np.full(band.vertex_count, 0.5)] * 2), ("lower", "upper"))
+    guarded = transfer_weights(source, weights, band, protected=bottom, protected_weights=kept)
+    np.testing.assert_array_equal(guarded.weights.matrix[bottom], [[0.5, 0.5]] * int(bottom.sum()))
+    np.testing.assert_array_equal(guarded.weights.matrix[~bottom], [[0.0, 1.0]] * int((~bottom).sum()))
+
+
+def test_a_target_wholly_on_one_bone_already_is_left_as_it_is_without_a_note(body):
+    source, weights = body
+    cuff = sleeve(z0=0.75, height=0.2, rings=5)
+    result = transfer_weights(source, weights, cuff)
+    np.testing.assert_array_equal(result.weights.matrix, [[0.0, 1.0]] * cuff.vertex_count)
+    assert result.rigid_bone == "" and "rigid" not in result.summary()
+
+
+def test_a_target_spanning_the_joint_keeps_its_blend(body):
+    # A sleeve over both bones (z 0.3 to 0.7): half its weight on each, nothing bound.
+    source, weights = body
+    target = sleeve(z0=0.3, height=0.4, rings=13)
+    result = transfer_weights(source, weights, target)
+    assert result.rigid_bone == ""
+    np.testing.assert_allclose(result.weights.matrix, transfer_weights(
+        source, weights, target, TransferOptions(rigid_accessory=False)).weights.matrix, atol=0)
+    assert 0.3 < result.weights.matrix[:, 1].mean() < 0.7

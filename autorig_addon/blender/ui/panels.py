@@ -84,6 +84,7 @@ class VIEW3D_PT_autorig_transfer(_AutoRigSubPanel, bpy.types.Panel):
         row.active = settings.smoothing_iterations > 0
         row.prop(settings, "smoothing_strength")
         column.prop(settings, "max_influences")
+        column.prop(settings, "rigid_accessory")
 
         mask_target = settings.target or context.active_object
         column = layout.column(align=True)

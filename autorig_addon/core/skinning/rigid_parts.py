@@ -74,17 +74,31 @@ def rigid_weights(mesh: Mesh, weights: np.ndarray, share: float = RIGID_SHARE) -
     if count < 2:
         return weights, 0
     weighted = (weights > 0).any(axis=1)
-    mass = np.zeros((count, weights.shape[1]))
-    # Area-weighted, so a finely tessellated corner does not outvote the rest of the part.
-    np.add.at(mass, labels, weights * np.maximum(voronoi_mass(mesh.vertices, mesh.triangles), 1e-30)[:, None])
-    totals = mass.sum(axis=1)
-    bone = mass.argmax(axis=1)
-    rigid = (totals > 0) & (mass[np.arange(count), bone] >= share * totals)
+    bone = dominant_bones(labels, weights, voronoi_mass(mesh.vertices, mesh.triangles), share)
+    rigid = bone >= 0
     moved = rigid[labels] & weighted
     result = weights.copy()
     result[moved] = 0.0
     result[np.flatnonzero(moved), bone[labels[moved]]] = 1.0
     return result, int(np.count_nonzero(rigid))
+
+
+def dominant_bones(labels: np.ndarray, weights: np.ndarray, areas: np.ndarray,
+                   share: float = RIGID_SHARE) -> np.ndarray:
+    """For each part (``labels``: (n,) int, 0 to k - 1), the bone (column of
+    ``weights``, (n, b)) holding at least ``share`` of its weight, each
+    vertex counted by its area (``areas``, (n,): its Voronoi mass); -1 where
+    no bone does. (k,) int array."""
+    count = int(labels.max()) + 1 if len(labels) else 0
+    if not weights.shape[1]:
+        return np.full(count, -1, dtype=np.int64)
+    mass = np.zeros((count, weights.shape[1]))
+    # Area-weighted, so a finely tessellated corner does not outvote the rest of the part.
+    np.add.at(mass, labels, weights * np.maximum(areas, 1e-30)[:, None])
+    totals = mass.sum(axis=1)
+    bone = mass.argmax(axis=1)
+    held = (totals > 0) & (mass[np.arange(count), bone] >= share * totals)
+    return np.where(held, bone, -1)
 
 
 #: Rigify's generated rig prefixes its deforming bones so (``DEF-spine.006``) ...

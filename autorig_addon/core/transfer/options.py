@@ -63,6 +63,9 @@ GROUP_MEMBER_THRESHOLD = 0.5
 #: By default a transfer where almost nothing matches, or where matches are
 #: far from the body, is refused (a unit mix-up or a garment off the body).
 DEFAULT_ALLOW_POOR_MATCH = False
+#: By default a target whose weights lie almost wholly on one bone (a hat on
+#: the head) is bound wholly to it (``transfer.rigid_accessory_bone``).
+DEFAULT_RIGID_ACCESSORY = True
 
 
 @dataclass(frozen=True)
@@ -96,6 +99,10 @@ class TransferOptions:
     allow_poor_match : bool
         Transfer even when almost nothing matches or matches are far from
         the body (see ``transfer.check_match_quality``), instead of refusing.
+    rigid_accessory : bool
+        Bind a target whose transferred weights lie almost wholly on one bone
+        (a hat, a helmet, a bracer) wholly to that bone, so that it moves as
+        one piece (see ``transfer.rigid_accessory_bone``).
     """
 
     distance_fraction: float = DEFAULT_DISTANCE_FRACTION
@@ -107,6 +114,7 @@ class TransferOptions:
     smoothing_strength: float = DEFAULT_SMOOTHING_STRENGTH
     max_influences: int = DEFAULT_MAX_INFLUENCES
     allow_poor_match: bool = DEFAULT_ALLOW_POOR_MATCH
+    rigid_accessory: bool = DEFAULT_RIGID_ACCESSORY
 
 
 #: Which bones' weights the panel transfers (``bone_subset``; from a script
@@ -146,6 +154,9 @@ TRANSFER_OPTIONS = option_table(
     Option("allow_poor_match", bool, DEFAULT_ALLOW_POOR_MATCH, "Allow Poor Match",
            "Transfer even when almost nothing matches, another unit scale fits much better, or matches are far "
            "from the body (otherwise refused: usually a unit mix-up or a garment off the body)"),
+    Option("rigid_accessory", bool, DEFAULT_RIGID_ACCESSORY, "Rigid Accessory",
+           "Bind a target whose weights lie nine tenths or more on one bone (a hat, a helmet, a bracer) wholly to that "
+           "bone, so that it moves as one piece"),
     Option("mask_group", str, DEFAULT_MASK_GROUP, "Inpaint Mask",
            f"Vertex group on the target whose vertices (weight {GROUP_MEMBER_THRESHOLD:g} or more) are always "
            "inpainted, never copied"),

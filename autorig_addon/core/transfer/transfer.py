@@ -19,6 +19,11 @@ Two stages, and a third of ours:
    where they do. Measured against the published implementation, which
    smooths the inpainted band by uniform passes, this gives less stretch
    for less deformation error (docs/transfer.md).
+4. **A rigid accessory** (:func:`rigid_accessory_bone`). A target whose
+   weights lie nine tenths or more on one bone (a hat on the head, a bracer
+   on a forearm) is bound wholly to it, as skinning binds such loose parts
+   (:mod:`..skinning.rigid_parts`): the rest is the blur at its edge (a hat's
+   brim reaching toward the neck), which bent it when the head turned.
 
 This module runs them: beyond the paper, seams are welded before inpainting
 (glTF and FBX split vertices at UV seams, which would cut the Laplacian into
@@ -50,6 +55,7 @@ from ..geometry.smoothing import smooth_over_edges, smooth_over_surface
 from ..geometry.topology import connected_component_labels, non_manifold_edge_count
 from ..geometry.weld import weld_mesh
 from ..progress import ProgressCallback, report
+from ..skinning.rigid_parts import dominant_bones
 from ..types import Mesh, Weights
 from ..weights import empty_rows, limit_influences, normalize_rows, prune_small
 from .inpainting import inpaint_weights, inpainting_operator
@@ -113,6 +119,8 @@ class TransferResult:
         but whose closest source point has none usable: inpainted instead
     unprotected : int, protected vertices with no weight to keep on the
         source's bones: they were transferred instead
+    rigid_bone : str, the bone the target was bound wholly to as a rigid
+        accessory (:func:`rigid_accessory_bone`); "" when it was not
     """
 
     weights: Weights
@@ -126,6 +134,7 @@ class TransferResult:
     invalid_source_vertices: int = 0
     near_unweighted: int = 0
     unprotected: int = 0
+    rigid_bone: str = ""
 
     def summary(self) -> str:
         counts = np.bincount(self.status, minlength=len(VertexStatus))
@@ -144,6 +153,9 @@ class TransferResult:
                          f"weight{invalid}; {self.near_unweighted} vertices near them were inpainted")
         if self.unprotected:
             parts.append(f"{self.unprotected} protected vertices had no weight to keep and were transferred")
+        if self.rigid_bone:
+            parts.append(f"bound wholly to bone '{self.rigid_bone}' (a rigid accessory: nine tenths or more of its "
+                         "weight lay there)")
         if self.welded_vertices:
             parts.append(f"{self.welded_vertices} seam duplicates welded")
         if self.non_manifold_edges:
@@ -275,6 +287,10 @@ def transfer_weights(
     )
     solved = smooth_over_edges(solved, welded_F, options.smoothing_iterations, options.smoothing_strength, rows=~known)
     solved = prune_small(limit_influences(solved, options.max_influences))
+    rigid = rigid_accessory_bone(solved, operators.mass, ~protected_welded) if options.rigid_accessory else None
+    if rigid is not None:
+        solved[~protected_welded] = 0.0
+        solved[~protected_welded, rigid] = 1.0
     timings["smooth"] = time.perf_counter() - clock
     report(progress, 0.9, "Writing results")
 
@@ -296,7 +312,30 @@ def transfer_weights(
         invalid_source_vertices=source.invalid_count,
         near_unweighted=int(np.count_nonzero(near_unweighted)),
         unprotected=int(np.count_nonzero(unprotected)),
+        rigid_bone=source_weights.bone_names[bones[rigid]] if rigid is not None else "",
     )
+
+
+def rigid_accessory_bone(weights: np.ndarray, areas: np.ndarray, rows: np.ndarray) -> int | None:
+    """The column of ``weights`` ((n, b), rows summing to one) holding at
+    least :data:`..skinning.rigid_parts.RIGID_SHARE` of the weight of the
+    ``rows`` ((n,) bool: the vertices being transferred, not protected), each
+    counted by its area (``areas``, (n,)); None when no bone does, no row
+    is transferred, or those rows lie wholly on it already (nothing to bind).
+
+    Artists bind a hat, a helmet or a bracer wholly to one bone. Only the
+    target as a whole is judged: a small part sewn on cloth (a shoe's
+    eyelets, a button) follows the cloth under it, and bound rigidly to one
+    bone it parts from it (on the makehuman shoes03, its 8 eyelet parts so
+    bound raise the deformation error from 0.0461 to 0.0477 % of the body's
+    height).
+    """
+    if not rows.any():
+        return None
+    bone = int(dominant_bones(np.zeros(int(rows.sum()), dtype=np.int64), weights[rows], areas[rows])[0])
+    if bone < 0 or np.all(weights[rows, bone] == 1.0):
+        return None
+    return bone
 
 
 def check_match_quality(source: TransferSource, target: Mesh, target_normals: np.ndarray, matches: Matches,
