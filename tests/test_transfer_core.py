@@ -620,6 +620,19 @@ def test_a_target_lying_nine_tenths_on_one_bone_is_bound_wholly_to_it(body):
     np.testing.assert_array_equal(guarded.weights.matrix[~bottom], [[0.0, 1.0]] * int((~bottom).sum()))
 
 
+def test_a_target_nine_tenths_on_one_bone_that_touches_the_body_across_the_joint_keeps_its_blend(body):
+    # A band from z 0.48 to 0.95: 'upper' holds about 0.92 of its weight, but its rows copied below z 0.5 lie mostly
+    # on 'lower' (a head of its own with its neck: it reaches across the joint and must bend there).
+    source, weights = body
+    band = sleeve(z0=0.48, height=0.47, rings=11)
+    result = transfer_weights(source, weights, band)
+    assert result.rigid_bone == ""
+    below = band.vertices[:, 2] < 0.5
+    assert np.all(result.weights.matrix[below, 0] > 0.5)
+    share = np.average(result.weights.matrix[:, 1], weights=voronoi_mass(band.vertices, band.triangles))
+    assert share > 0.9
+
+
 def test_a_target_wholly_on_one_bone_already_is_left_as_it_is_without_a_note(body):
     source, weights = body
     cuff = sleeve(z0=0.75, height=0.2, rings=5)
