@@ -610,13 +610,15 @@ def test_a_target_lying_nine_tenths_on_one_bone_is_bound_wholly_to_it(body):
     result = transfer_weights(source, weights, band)
     np.testing.assert_array_equal(result.weights.matrix, [[0.0, 1.0]] * band.vertex_count)
     assert result.rigid_bone == "upper"
-    assert result.summary().endswith("bound wholly to bone 'upper' (a rigid accessory: nine tenths or more of its "
-                                     "weight lay there)")
-    # Protected rows keep their own weights; the rest is bound.
-    bottom = band.vertices[:, 2] < 0.6
-    kept = Weights(np.column_stack([np.full(band.vertex_count, 0.5)] * 2), ("lower", "upper"))
+    assert result.summary().endswith("bound wholly to bone 'upper' (a rigid accessory: 90% or more of its weight "
+                                     "lay there)")
+    # Protected rows keep their own weights and are not judged: the lower half of the band kept wholly on 'lower'
+    # would pull 'upper' far under 0.9 if it counted; the rest is bound.
+    bottom = band.vertices[:, 2] < 0.75
+    kept = Weights(np.column_stack([np.ones(band.vertex_count), np.zeros(band.vertex_count)]), ("lower", "upper"))
     guarded = transfer_weights(source, weights, band, protected=bottom, protected_weights=kept)
-    np.testing.assert_array_equal(guarded.weights.matrix[bottom], [[0.5, 0.5]] * int(bottom.sum()))
+    assert guarded.rigid_bone == "upper"
+    np.testing.assert_array_equal(guarded.weights.matrix[bottom], [[1.0, 0.0]] * int(bottom.sum()))
     np.testing.assert_array_equal(guarded.weights.matrix[~bottom], [[0.0, 1.0]] * int((~bottom).sum()))
 
 
@@ -631,6 +633,11 @@ def test_a_target_nine_tenths_on_one_bone_that_touches_the_body_across_the_joint
     assert np.all(result.weights.matrix[below, 0] > 0.5)
     share = np.average(result.weights.matrix[:, 1], weights=voronoi_mass(band.vertices, band.triangles))
     assert share > 0.9
+    # Only where it is copied from the body does the body tell: with those rows inpainted instead (a hat's brim
+    # standing off the neck), nothing copied lies on 'lower', and the band is bound.
+    brim = transfer_weights(source, weights, band, inpaint_mask=below)
+    assert brim.rigid_bone == "upper"
+    np.testing.assert_array_equal(brim.weights.matrix, [[0.0, 1.0]] * band.vertex_count)
 
 
 def test_a_target_wholly_on_one_bone_already_is_left_as_it_is_without_a_note(body):

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from ..geometry.smoothing import DEFAULT_SMOOTHING_STRENGTH, MAX_SMOOTHING_ITERATIONS
 from ..options import DEGREES, FRACTION, LENGTH, Choice, Option, option_table
+from ..skinning.rigid_parts import RIGID_SHARE
 from ..weights import MAX_INFLUENCES
 from . import combine
 
@@ -100,9 +101,10 @@ class TransferOptions:
         Transfer even when almost nothing matches or matches are far from
         the body (see ``transfer.check_match_quality``), instead of refusing.
     rigid_accessory : bool
-        Bind a target whose transferred weights lie almost wholly on one bone
-        (a hat, a helmet, a bracer) wholly to that bone, so that it moves as
-        one piece (see ``transfer.rigid_accessory_bone``).
+        Bind a target whose transferred weights lie mostly on one bone (a
+        hat, a helmet, a bracer) wholly to that bone, so that it moves as one
+        piece, unless where it touches the body the body's weights lie
+        mostly on another bone (see ``transfer.rigid_accessory_bone``).
     """
 
     distance_fraction: float = DEFAULT_DISTANCE_FRACTION
@@ -155,8 +157,9 @@ TRANSFER_OPTIONS = option_table(
            "Transfer even when almost nothing matches, another unit scale fits much better, or matches are far "
            "from the body (otherwise refused: usually a unit mix-up or a garment off the body)"),
     Option("rigid_accessory", bool, DEFAULT_RIGID_ACCESSORY, "Rigid Accessory",
-           "Bind a target whose weights lie nine tenths or more on one bone (a hat, a helmet, a bracer) wholly to that "
-           "bone, so that it moves as one piece"),
+           f"Bind a target with a share of {RIGID_SHARE:g} or more of its weight on one bone (a hat, a helmet, a "
+           "bracer) wholly to that bone, so that it moves as one piece, unless where it touches the body the body's "
+           "weights lie mostly on another bone"),
     Option("mask_group", str, DEFAULT_MASK_GROUP, "Inpaint Mask",
            f"Vertex group on the target whose vertices (weight {GROUP_MEMBER_THRESHOLD:g} or more) are always "
            "inpainted, never copied"),

@@ -1,6 +1,6 @@
 """Robust skin weight transfer (Abdrashitov et al., SIGGRAPH Asia 2023).
 
-Two stages, and a third of ours:
+Two stages, and two of ours:
 
 1. **Matching** (:mod:`.matching`). Each target vertex looks up the closest
    point on the source surface. Its weights are copied (barycentric
@@ -20,10 +20,11 @@ Two stages, and a third of ours:
    smooths the inpainted band by uniform passes, this gives less stretch
    for less deformation error (docs/transfer.md).
 4. **A rigid accessory** (:func:`rigid_accessory_bone`). A target whose
-   weights lie nine tenths or more on one bone (a hat on the head, a bracer
-   on a forearm) is bound wholly to it, as skinning binds such loose parts
-   (:mod:`..skinning.rigid_parts`): the rest is the blur at its edge (a hat's
-   brim reaching toward the neck), which bent it when the head turned.
+   weights lie mostly on one bone (a hat on the head, a bracer on a forearm),
+   as skinning judges loose parts (:mod:`..skinning.rigid_parts`), and that
+   touches the body only where the body's weights lie mostly on that bone,
+   is bound wholly to it: the rest is the blur at its edge (a hat's brim
+   reaching toward the neck), which bent it when the head turned.
 
 This module runs them: beyond the paper, seams are welded before inpainting
 (glTF and FBX split vertices at UV seams, which would cut the Laplacian into
@@ -55,7 +56,7 @@ from ..geometry.smoothing import smooth_over_edges, smooth_over_surface
 from ..geometry.topology import connected_component_labels, non_manifold_edge_count
 from ..geometry.weld import weld_mesh
 from ..progress import ProgressCallback, report
-from ..skinning.rigid_parts import dominant_bones
+from ..skinning.rigid_parts import RIGID_SHARE, dominant_bones
 from ..types import Mesh, Weights
 from ..weights import empty_rows, limit_influences, normalize_rows, prune_small
 from .inpainting import inpaint_weights, inpainting_operator
@@ -154,8 +155,8 @@ class TransferResult:
         if self.unprotected:
             parts.append(f"{self.unprotected} protected vertices had no weight to keep and were transferred")
         if self.rigid_bone:
-            parts.append(f"bound wholly to bone '{self.rigid_bone}' (a rigid accessory: nine tenths or more of its "
-                         "weight lay there)")
+            parts.append(f"bound wholly to bone '{self.rigid_bone}' (a rigid accessory: {RIGID_SHARE:.0%} or more of "
+                         "its weight lay there)")
         if self.welded_vertices:
             parts.append(f"{self.welded_vertices} seam duplicates welded")
         if self.non_manifold_edges:
@@ -288,8 +289,9 @@ def transfer_weights(
     solved = smooth_over_edges(solved, welded_F, options.smoothing_iterations, options.smoothing_strength, rows=~known)
     solved = prune_small(limit_influences(solved, options.max_influences))
     copied = (status == VertexStatus.COPIED) | (status == VertexStatus.COPIED_FLIPPED)
-    rigid = (rigid_accessory_bone(solved, operators.mass, ~protected_welded, copied) if options.rigid_accessory
-             else None)
+    rigid = None
+    if options.rigid_accessory:
+        rigid = rigid_accessory_bone(solved, operators.mass, ~protected_welded, copied, fallback)
     if rigid is not None:
         solved[~protected_welded] = 0.0
         solved[~protected_welded, rigid] = 1.0
@@ -318,18 +320,20 @@ def transfer_weights(
     )
 
 
-def rigid_accessory_bone(weights: np.ndarray, areas: np.ndarray, rows: np.ndarray, copied: np.ndarray) -> int | None:
+def rigid_accessory_bone(weights: np.ndarray, areas: np.ndarray, rows: np.ndarray, copied: np.ndarray,
+                         body_weights: np.ndarray) -> int | None:
     """The bone (column of ``weights``, (n, b), rows summing to one) a
     target is bound wholly to as a rigid accessory, or None.
 
     It is the bone holding at least :data:`..skinning.rigid_parts.RIGID_SHARE`
     of the weight of the ``rows`` ((n,) bool: the vertices being transferred,
     not protected), each counted by its area (``areas``, (n,)), when no row
-    ``copied`` from the body ((n,) bool) lies mostly on another bone: where
-    the target touches the body, the body says it all belongs to that bone,
-    and the rest of its weight is what the inpainting and smoothing spread
-    (the fedora's brim). None too when no row is transferred or they lie
-    wholly on the bone already (nothing to bind).
+    ``copied`` from the body ((n,) bool) had more of ``body_weights`` (the
+    body's, (n, b), as matched, before inpainting and smoothing) on another
+    bone: where the target touches the body, the body says it all belongs
+    to that bone, and the rest of its weight is what the inpainting and
+    smoothing spread (the fedora's brim). None too when no row is
+    transferred or they lie wholly on the bone already (nothing to bind).
 
     Artists bind a hat, a helmet or a bracer wholly to one bone. A head of
     its own with its neck (Quaternius' modular characters: 92 to 99 % head)
@@ -346,7 +350,7 @@ def rigid_accessory_bone(weights: np.ndarray, areas: np.ndarray, rows: np.ndarra
     if bone < 0 or np.all(weights[rows, bone] == 1.0):
         return None
     touching = rows & copied
-    if touching.any() and np.any(weights[touching].argmax(axis=1) != bone):
+    if np.any(body_weights[touching, bone] < body_weights[touching].max(axis=1)):
         return None
     return bone
 
