@@ -7,11 +7,11 @@ lies near enough to tell their kind (:func:`.rig_library.nearest_known_body`).
 Its biped landmarks on them still describe the body a person sees: four
 limbs and a trunk inside the solid, two legs apart, a head on top. This
 module reads that layout (:func:`biped_layout`): a second opinion on the
-kind, asked only when the network reads no kind surely and no known body
-tells one.
+kind, asked only when the network reads no kind surely and no known biped
+lies near.
 
 Each test is a property of an upright two-legged body, not a tuned score;
-the one number, :data:`MIN_INSIDE_SHARE`, was checked on the training
+its numbers (:data:`MIN_INSIDE_SHARE`, :data:`MIN_TRUNK_RISE`) were checked on the training
 characters (2026-12-07, each read with itself and its near-duplicates left
 out of the rig library): no training fish, bird, quadruped or other body
 passes (their best: Quaternius' mechs, legs apart and upright, with a limb
