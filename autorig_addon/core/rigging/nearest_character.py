@@ -32,6 +32,7 @@ from ..errors import InputError
 from ..evaluation.skeleton_metrics import symmetric_chamfer
 from ..geometry.normals import triangle_double_areas
 from ..types import Mesh, Skeleton
+from .surface_fit import box_axis_map
 
 #: Points drawn on each normalised surface for the Chamfer distance. On a
 #: character of largest side 1, 2,000 points are about 2 cm apart on a
@@ -106,10 +107,9 @@ def surface_points(vertices: np.ndarray, triangles: np.ndarray, count: int = SUR
 
 def box_map(points: np.ndarray, source_vertices: np.ndarray, target_vertices: np.ndarray) -> np.ndarray:
     """``points`` moved by the per-axis affine map taking the bounding box of
-    ``source_vertices`` onto that of ``target_vertices``.
-
-    Along an axis where the source box is flat, points are only shifted (by
-    the difference of the box centres).
+    ``source_vertices`` onto that of ``target_vertices``
+    (:func:`.surface_fit.box_axis_map`: along an axis where the source box is
+    flat, points are only shifted).
 
     Parameters
     ----------
@@ -120,13 +120,12 @@ def box_map(points: np.ndarray, source_vertices: np.ndarray, target_vertices: np
     -------
     mapped : (k, 3) float64 array
     """
-    source_low, source_high = source_vertices.min(axis=0), source_vertices.max(axis=0)
-    target_low, target_high = target_vertices.min(axis=0), target_vertices.max(axis=0)
-    source_extent, target_extent = source_high - source_low, target_high - target_low
-    flat = source_extent <= 0.0
-    scale = np.where(flat, 1.0, target_extent / np.where(flat, 1.0, source_extent))
-    source_centre, target_centre = (source_low + source_high) / 2.0, (target_low + target_high) / 2.0
-    return (np.asarray(points, dtype=np.float64) - source_centre) * scale + target_centre
+    return box_axis_map(_bounds(source_vertices), _bounds(target_vertices))(points)
+
+
+def _bounds(vertices: np.ndarray) -> np.ndarray:
+    vertices = np.asarray(vertices, dtype=np.float64)
+    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
 
 
 def nearest_character(mesh: Mesh, pool: Sequence[CharacterSample], exclude: Collection[str] = ()) -> NearestCharacter:

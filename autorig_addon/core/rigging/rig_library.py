@@ -18,8 +18,9 @@ the landmark network reads surely as one of those kinds (or a biped by its
 nearest known body) finds the entry of its kind with key joints whose
 surface is nearest (symmetric Chamfer distance, in units of the largest side) when that distance is at
 most :data:`LIBRARY_DISTANCE`; a standard skeleton of that kind (not of a
-kind the user forces instead) takes the entry's key joints, mapped by the
-per-axis affine map between the two bounding boxes, and the landmark
+kind the user forces instead) takes the entry's key joints, mapped by a
+scale and a shift per axis (:func:`entry_map`: the bounding boxes' map,
+refined on the two surfaces where that brings them closer), and the landmark
 network's stay for the key joints the entry lacks (KayKit's rigs have no
 neck). Run on a training character, the search finds that character itself.
 
@@ -51,9 +52,10 @@ from ..evaluation.skeleton_metrics import symmetric_chamfer
 from ..skeleton.hierarchy import ancestors, parents_first_order, reindexed_parents, subset_parents
 from ..skeleton.key_joints import KEY_JOINT_TWINS, KEY_JOINTS
 from ..types import Mesh, Skeleton
-from .nearest_character import SURFACE_POINTS, box_map, surface_points
+from .nearest_character import SURFACE_POINTS, surface_points
 from .networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from .networks.trained import TRAINED_FOLDER
+from .surface_fit import AxisMap, fitted_axis_map
 from .symmetry import mirror_points
 
 #: The shipped library.
@@ -331,17 +333,24 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     if found is None:
         return None
     best, distance = found
-    low, high = library.boxes[best].astype(np.float64)
-    mapped = box_map(library.key_joints[best].astype(np.float64), np.array([low, high]),
-                     np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
+    mapped = entry_map(library, best, surface)(library.key_joints[best])
     points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
     return ClosestRig(str(library.names[best]), distance, points)
 
 
+def entry_map(library: RigLibrary, entry: int, surface: Mesh) -> AxisMap:
+    """The per-axis map taking entry ``entry``'s body onto ``surface``
+    (normalised frame): its bounding box onto the surface's, refined on the
+    two surfaces (:func:`.surface_fit.fitted_axis_map`)."""
+    return fitted_axis_map(library.points[entry], library.boxes[entry],
+                           surface_points(surface.vertices, surface.triangles, SURFACE_POINTS),
+                           np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
+
+
 def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | None = None) -> KnownRig | None:
     """The rig of the entry ``name`` (found ``distance`` from ``surface``,
-    normalised frame) mapped by the per-axis affine map between the two
-    bounding boxes, as its key joints are (:func:`closest_rig`); None when
+    normalised frame) mapped onto it as its key joints are
+    (:func:`closest_rig`, :func:`entry_map`); None when
     that is farther than :data:`LIBRARY_DISTANCE` or the entry keeps no rig."""
     library = shipped_library() if library is None else library
     if library is None or distance > LIBRARY_DISTANCE:
@@ -351,10 +360,8 @@ def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | 
         return None
     entry = int(found[0])
     rows = library.rig_rows(entry)
-    source = library.boxes[entry].astype(np.float64)
-    target = np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)])
-    joints, tails = (box_map(points[rows].astype(np.float64), source, target)
-                     for points in (library.rig_joints, library.rig_tails))
+    fitted = entry_map(library, entry, surface)
+    joints, tails = fitted(library.rig_joints[rows]), fitted(library.rig_tails[rows])
     skeleton = Skeleton(joints, library.rig_parents[rows].copy(), tuple(str(bone) for bone in library.rig_names[rows]),
                         tails, library.rig_deform[rows].copy())
     return KnownRig(name, str(library.kinds[entry]), distance, skeleton)
