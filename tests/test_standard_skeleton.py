@@ -216,8 +216,16 @@ def test_a_bipeds_head_joint_is_drawn_toward_its_neck_to_a_neck_length():
     np.testing.assert_array_equal(head_near_neck(short)["head"], [0.0, 0.0, 0.84])
 
 
-def votes_with(kind_probabilities):
-    landmarks = Landmarks({name: np.zeros(3) for name in LANDMARKS}, kind_probabilities)
+#: Heights of a standing body's landmarks: each leg (and a quadruped's front leg) going down, the hips above the knees.
+STANDING_HEIGHTS = {"hips": 0.5, "neck": 0.8, "head": 0.9, "shoulder": 0.45, "elbow": 0.25, "wrist": 0.05,
+                    "hip": 0.45, "knee": 0.25, "ankle": 0.05}
+
+
+def votes_with(kind_probabilities, **heights):
+    """Votes whose landmarks stand at :data:`STANDING_HEIGHTS` but for ``heights`` (landmark name: z)."""
+    points = {name: np.array([0.0, 0.0, heights.get(name, STANDING_HEIGHTS[name.partition(".")[0]])])
+              for name in LANDMARKS}
+    landmarks = Landmarks(points, kind_probabilities)
     return predict.JointVotes(np.zeros((1, 3)), np.ones(1), None, np.eye(4), True, (), landmarks, np.zeros((1, 3)))
 
 
@@ -233,6 +241,27 @@ def test_the_template_is_the_networks_kind_when_it_is_sure_or_the_users_choice(p
     chosen, note = predict.chosen_template(votes_with(probabilities), template)
     assert chosen == kind
     assert note.startswith("Template: ") and (template == "free-form" or "% sure" in note)
+
+
+def test_auto_gives_the_free_form_skeleton_when_the_kinds_landmarks_are_out_of_order():
+    sure_biped = {"biped": 0.99, "quadruped": 0.005, "other": 0.005}
+    # The trunk read hanging from below a knee (the posed GDQuest mannequin): a standard biped would be wrong at sight.
+    low_hips = votes_with(sure_biped, hips=0.2)
+    chosen, note = predict.chosen_template(low_hips)
+    assert chosen == FREE_FORM
+    assert note == ("Template: free-form skeleton, because the biped landmarks are out of order (the hips lie below a "
+                    "knee; the landmark network reads the body as biped (99% sure)); choose a biped or quadruped "
+                    "template to force one.")
+    # Asked for, the biped is given, and the report's warnings say what looks wrong.
+    assert predict.chosen_template(low_hips, BIPED)[0] == BIPED
+    # A quadruped's front leg whose knee is read below its ankle.
+    sure_quadruped = {"biped": 0.005, "quadruped": 0.99, "other": 0.005}
+    chosen, note = predict.chosen_template(votes_with(sure_quadruped, **{"elbow.R": 0.02}))
+    assert chosen == FREE_FORM
+    assert "(the right front hip joint, right front knee and right front ankle do not go down the leg in order;" in note
+    # The same landmarks in order: the standard skeletons.
+    assert predict.chosen_template(votes_with(sure_biped))[0] == BIPED
+    assert predict.chosen_template(votes_with(sure_quadruped))[0] == QUADRUPED
 
 
 def test_an_unknown_template_is_refused():

@@ -58,6 +58,7 @@ from .standard_skeleton import (
     NEAR_SYMMETRIC_ERROR,
     TEMPLATES,
     Landmarks,
+    landmark_disorder,
     landmark_warnings,
     predict_landmarks,
     standard_confidence,
@@ -504,7 +505,9 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
     probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`, else
     the kind of the body's nearest known body when it gave one
     (:data:`RELATIVE_KINDS`), else a biped when its landmarks are laid out
-    as one (:attr:`.standard_skeleton.Landmarks.layout`).
+    as one (:attr:`.standard_skeleton.Landmarks.layout`); but the free-form
+    skeleton when that kind's landmarks are out of the order a standing body
+    has them (:func:`.standard_skeleton.landmark_disorder`).
     """
     if template not in TEMPLATES:
         raise InputError(f"Unknown template '{template}': use one of {', '.join(TEMPLATES)}.")
@@ -517,9 +520,14 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
     if known_rig and votes.known_rig is not None:
         return KNOWN_RIG, (f"{votes.known_rig.note}; {seen}. Choose the Biped or Quadruped template for a standard "
                            "skeleton (and Rigify's control rig).")
+    kind = guess if votes.landmarks.read_surely else sure_standard_kind(votes.landmarks)
+    disorder = landmark_disorder(votes.landmarks, kind) if kind is not None else ()
+    if disorder:
+        # A standard skeleton hung on these would be wrong at first sight; the free-form one follows the mesh.
+        return FREE_FORM, (f"Template: free-form skeleton, because the {kind} landmarks are out of order ("
+                           f"{'; '.join(disorder)}; {seen}); choose a biped or quadruped template to force one.")
     if votes.landmarks.read_surely:
         return guess, f"Template: standard {guess} skeleton; {seen}."
-    kind = sure_standard_kind(votes.landmarks)
     if kind is not None:
         return kind, (f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; "
                       f"{votes.landmarks.kind_told_by.note}.")

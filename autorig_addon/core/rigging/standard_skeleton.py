@@ -621,8 +621,8 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
 
     Returns
     -------
-    tuple of str: key joints outside the body, a leg whose joints do not
-    go down from the hip to the ankle, and a biped's hips below a knee.
+    tuple of str: key joints outside the body, then what
+    :func:`landmark_disorder` finds.
     """
     placed = landmarks.points_for(kind)
     names = list(placed)
@@ -632,19 +632,28 @@ def landmark_warnings(landmarks: Landmarks, kind: str, inside) -> tuple:
     outside = [_spoken(name, kind) for name, value in zip(names, depth) if value <= 0.0]
     if outside:
         notes.append(f"check the skeleton: the {', '.join(outside)} could not be placed inside the body")
+    return (*notes, *(f"check the skeleton: {problem}" for problem in landmark_disorder(landmarks, kind)))
+
+
+def landmark_disorder(landmarks: Landmarks, kind: str) -> tuple:
+    """The landmarks of ``kind`` out of the order a standing body has them,
+    as phrases: a leg (a quadruped's front legs too) whose joints do not go
+    down from the hip to the ankle, and a biped's hips below a knee; empty
+    when none is."""
+    placed = landmarks.points_for(kind)
+    problems = []
     legs = [("hip", "knee", "ankle")] + ([("shoulder", "elbow", "wrist")] if kind == QUADRUPED else [])
     for chain in legs:
         for side in (LEFT, RIGHT):
             heights = [placed[role + side][2] for role in chain]
             if not heights[0] > heights[1] > heights[2]:
-                notes.append(f"check the skeleton: the {_spoken(chain[0] + side, kind)}, "
-                             f"{_spoken(chain[1] + side, kind)} and {_spoken(chain[2] + side, kind)} do not go "
-                             "down the leg in order")
+                problems.append(f"the {_spoken(chain[0] + side, kind)}, {_spoken(chain[1] + side, kind)} and "
+                                f"{_spoken(chain[2] + side, kind)} do not go down the leg in order")
     if kind == BIPED and placed["hips"][2] <= max(placed["knee" + LEFT][2], placed["knee" + RIGHT][2]):
         # Of the 177 training humanoids' artists one put the hips below a knee (SuperTuxKart's Sara, a knee raised);
         # read so on a body standing, the trunk hangs from below the knees (the posed GDQuest mannequin).
-        notes.append("check the skeleton: the hips lie below a knee")
-    return tuple(notes)
+        problems.append("the hips lie below a knee")
+    return tuple(problems)
 
 
 def standard_skeleton(landmarks: Landmarks, kind: str, vertices: np.ndarray, symmetric_shape: bool,
