@@ -203,6 +203,14 @@ def procedural_sample(seed: int) -> CharacterSample:
                                           character.weights)
 
 
+def procedural_of_kind(kind: str, seed: int = 0):
+    """(normalised sample, generated character) of a procedural ``kind`` (``biped``, ``quadruped``, ``fish`` ...)."""
+    character = generate_character(seed, kind)
+    sample = CharacterSample.from_character(f"procedural/{kind}_{seed}", character.kind, character.mesh,
+                                            character.skeleton, character.weights)
+    return sample, character
+
+
 def random_skin_inputs(seed: int, vertex_count: int, bone_count: int):
     """Random inputs of ``features.skin_graph``: points in the unit cube with
     random triangles among all but the last vertex (which has no mesh edge),

@@ -1,6 +1,6 @@
 """The rig library (core/rigging/rig_library.py): a character read as a biped
 or a quadruped takes the key joints of the nearest known rig of its kind
-when that rig's surface lies near enough, mapped onto its bounding box; a
+when that rig's surface lies near enough, mapped onto it (tests/test_surface_fit.py); a
 body the landmark network reads as neither is a biped when its nearest known
 body is one, near enough."""
 
@@ -11,7 +11,6 @@ import pytest
 from scipy.spatial import cKDTree
 
 from autorig_addon.core.dataset.sample import CharacterSample
-from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict, rig_library
 from autorig_addon.core.rigging.nearest_character import SURFACE_POINTS, surface_points
 from autorig_addon.core.rigging.networks.landmarks import sample_landmarks
@@ -28,25 +27,18 @@ from autorig_addon.core.rigging.rig_library import (
 )
 from autorig_addon.core.skeleton.key_joints import KEY_JOINTS, key_joints
 from autorig_addon.core.types import Mesh, Skeleton
-
-
-def procedural(kind: str, seed: int = 0):
-    """(normalised sample, generated character) of a procedural ``kind``."""
-    character = generate_character(seed, kind)
-    sample = CharacterSample.from_character(f"procedural/{kind}_{seed}", character.kind, character.mesh,
-                                            character.skeleton, character.weights)
-    return sample, character
+from geometry_fixtures import procedural_of_kind
 
 
 @pytest.fixture(scope="module")
 def biped():
-    return procedural("biped")
+    return procedural_of_kind("biped")
 
 
 @pytest.fixture(scope="module")
 def library(biped):
     """A biped, a quadruped and a fish: the fish only tells a kind (other), with no key joints."""
-    return build_rig_library([biped[0], procedural("quadruped")[0], procedural("fish")[0]])
+    return build_rig_library([biped[0], procedural_of_kind("quadruped")[0], procedural_of_kind("fish")[0]])
 
 
 def normalised_copy(sample: CharacterSample, factors) -> Mesh:
@@ -136,7 +128,7 @@ def test_only_a_rig_of_the_kind_read_and_near_enough_is_copied(library, biped):
     assert closest_rig(copy, "biped", only_quadruped, limit=np.inf) is None
     assert closest_rig(copy, "quadruped", library, limit=np.inf).name == "procedural/quadruped_0"
     # A generic body of another shape is no relative at the shipped limit.
-    other_biped = procedural("biped", seed=3)[0]
+    other_biped = procedural_of_kind("biped", seed=3)[0]
     assert closest_rig(Mesh(other_biped.vertices, other_biped.triangles), "biped", library) is None
 
 
@@ -183,7 +175,7 @@ def test_the_nearest_known_body_of_any_kind_tells_its_kind(library, biped):
     relative = nearest_known_body(normalised_copy(biped[0], [1.0, 1.0, 1.0]), library)
     assert (relative.name, relative.kind, relative.distance) == ("procedural/biped_0", "biped",
                                                                       pytest.approx(0.0022, abs=3e-4))
-    fish = procedural("fish")[0]
+    fish = procedural_of_kind("fish")[0]
     assert nearest_known_body(normalised_copy(fish, [1.0, 1.0, 1.0]), library).kind == "other"
     # Stretched 30 % across: 0.016 away, a relative within the limit but not within half that distance.
     stretched = normalised_copy(biped[0], [1.3, 1.0, 1.0])
@@ -220,8 +212,8 @@ def test_a_body_read_as_other_is_a_biped_when_its_nearest_known_body_is(library,
 def test_a_quadruped_nearest_gives_no_kind(library, read_as_other, monkeypatch):
     # The quadruped itself is known, 0 away: bipeds alone are given by their nearest known body.
     monkeypatch.setattr(rig_library, "shipped_library", lambda: library)
-    quadruped = procedural("quadruped")[1]
-    assert nearest_known_body(normalised_copy(procedural("quadruped")[0], [1.0, 1.0, 1.0]), library).kind == "quadruped"
+    sample, quadruped = procedural_of_kind("quadruped")
+    assert nearest_known_body(normalised_copy(sample, [1.0, 1.0, 1.0]), library).kind == "quadruped"
     votes = predict.predict_votes(quadruped.mesh)
     assert votes.landmarks.relative is None
     assert predict.chosen_template(votes, known_rig=False)[0] == "free-form"

@@ -1,5 +1,7 @@
 """The standard biped and quadruped skeletons laid out around landmarks, and the template choice."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
@@ -11,6 +13,7 @@ from autorig_addon.core.rigging import predict
 from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.rigging.metarig import metarig_placement
 from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.core.rigging.rig_library import KnownRelative, KnownRig
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
     FREE_FORM,
@@ -250,7 +253,7 @@ def test_auto_gives_the_free_form_skeleton_when_the_kinds_landmarks_are_out_of_o
     chosen, note = predict.chosen_template(low_hips)
     assert chosen == FREE_FORM
     assert note == ("Template: free-form skeleton, because the biped landmarks are out of order (the hips lie below a "
-                    "knee; the landmark network reads the body as biped (99% sure)); choose a biped or quadruped "
+                    "knee); the landmark network reads the body as biped (99% sure); choose a biped or quadruped "
                     "template to force one.")
     # Asked for, the biped is given, and the report's warnings say what looks wrong.
     assert predict.chosen_template(low_hips, BIPED)[0] == BIPED
@@ -258,7 +261,21 @@ def test_auto_gives_the_free_form_skeleton_when_the_kinds_landmarks_are_out_of_o
     sure_quadruped = {"biped": 0.005, "quadruped": 0.99, "other": 0.005}
     chosen, note = predict.chosen_template(votes_with(sure_quadruped, **{"elbow.R": 0.02}))
     assert chosen == FREE_FORM
-    assert "(the right front hip joint, right front knee and right front ankle do not go down the leg in order;" in note
+    assert "(the right front hip joint, right front knee and right front ankle do not go down the leg in order);" \
+        in note
+    # A biped by its nearest known body, not by the network: the note says what told the kind.
+    other = {"biped": 0.1, "quadruped": 0.1, "other": 0.8}
+    by_relative = votes_with(other, hips=0.2)
+    by_relative = replace(by_relative, landmarks=replace(by_relative.landmarks,
+                                                         relative=KnownRelative("known/biped", BIPED, 0.03)))
+    chosen, note = predict.chosen_template(by_relative)
+    assert chosen == FREE_FORM
+    assert note.endswith("reads the body as other (80% sure), not surely a biped or quadruped; the closest known body, "
+                         "known/biped (0.030 of the largest side away), is a biped; choose a biped or quadruped "
+                         "template to force one.")
+    # A known body's rig near enough is its artist's, whatever the landmarks: it is taken before them.
+    known = KnownRig("known/biped", BIPED, 0.01, Skeleton(np.zeros((1, 3)), np.array([-1]), ("root",), np.ones((1, 3))))
+    assert predict.chosen_template(replace(low_hips, known_rig=known))[0] == "known rig"
     # The same landmarks in order: the standard skeletons.
     assert predict.chosen_template(votes_with(sure_biped))[0] == BIPED
     assert predict.chosen_template(votes_with(sure_quadruped))[0] == QUADRUPED

@@ -32,7 +32,7 @@ from ..errors import InputError
 from ..evaluation.skeleton_metrics import symmetric_chamfer
 from ..geometry.normals import triangle_double_areas
 from ..types import Mesh, Skeleton
-from .surface_fit import box_axis_map
+from .surface_fit import bounding_box, box_axis_map
 
 #: Points drawn on each normalised surface for the Chamfer distance. On a
 #: character of largest side 1, 2,000 points are about 2 cm apart on a
@@ -120,12 +120,7 @@ def box_map(points: np.ndarray, source_vertices: np.ndarray, target_vertices: np
     -------
     mapped : (k, 3) float64 array
     """
-    return box_axis_map(_bounds(source_vertices), _bounds(target_vertices))(points)
-
-
-def _bounds(vertices: np.ndarray) -> np.ndarray:
-    vertices = np.asarray(vertices, dtype=np.float64)
-    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
+    return box_axis_map(bounding_box(source_vertices), bounding_box(target_vertices))(points)
 
 
 def nearest_character(mesh: Mesh, pool: Sequence[CharacterSample], exclude: Collection[str] = ()) -> NearestCharacter:

@@ -283,7 +283,9 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     if sure_standard_kind(landmarks):
         landmarks = replace(landmarks, closest_rig=closest_rig(normalised_surface, sure_standard_kind(landmarks)))
     near = landmarks.closest_rig or nearest
-    known = fitted_rig(near.name, near.distance, normalised_surface) if near is not None else None
+    # The closest rig's map is the fitted rig's too: the same entry onto the same surface.
+    axis_map = landmarks.closest_rig.axis_map if landmarks.closest_rig is not None else None
+    known = fitted_rig(near.name, near.distance, normalised_surface, axis_map=axis_map) if near is not None else None
     report(progress, 0.7, "Running the joint network")
     votes = graph_votes(weights, graph, solid, transform)
     if not votes.symmetric:
@@ -520,19 +522,18 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
     if known_rig and votes.known_rig is not None:
         return KNOWN_RIG, (f"{votes.known_rig.note}; {seen}. Choose the Biped or Quadruped template for a standard "
                            "skeleton (and Rigify's control rig).")
-    kind = guess if votes.landmarks.read_surely else sure_standard_kind(votes.landmarks)
-    disorder = landmark_disorder(votes.landmarks, kind) if kind is not None else ()
+    kind = sure_standard_kind(votes.landmarks)
+    if kind is None:
+        return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
+                           "force one.")
+    told = "" if votes.landmarks.read_surely else (f", not surely a biped or quadruped; "
+                                                   f"{votes.landmarks.kind_told_by.note}")
+    disorder = landmark_disorder(votes.landmarks, kind)
     if disorder:
         # A standard skeleton hung on these would be wrong at first sight; the free-form one follows the mesh.
         return FREE_FORM, (f"Template: free-form skeleton, because the {kind} landmarks are out of order ("
-                           f"{'; '.join(disorder)}; {seen}); choose a biped or quadruped template to force one.")
-    if votes.landmarks.read_surely:
-        return guess, f"Template: standard {guess} skeleton; {seen}."
-    if kind is not None:
-        return kind, (f"Template: standard {kind} skeleton; {seen}, not surely a biped or quadruped; "
-                      f"{votes.landmarks.kind_told_by.note}.")
-    return FREE_FORM, (f"Template: free-form skeleton, because {seen}; choose a biped or quadruped template to "
-                       "force one.")
+                           f"{'; '.join(disorder)}); {seen}{told}; choose a biped or quadruped template to force one.")
+    return kind, f"Template: standard {kind} skeleton; {seen}{told}."
 
 
 def graph_votes(weights: dict, graph: JointGraph, solid: SolidDepth | None = None,

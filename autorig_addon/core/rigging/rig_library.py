@@ -32,8 +32,9 @@ Each entry also keeps its artist's whole rig (the deform bones, names and
 parents, made one tree by :func:`_one_tree_rig`): a character with a known
 relative within :data:`LIBRARY_DISTANCE` gets that rig fitted to it by
 default (:func:`fitted_rig`, :data:`KNOWN_RIG`), as the closest-character
-baseline does but only where a relative is near: Quaternius' casual woman
-takes the joints, names and hierarchy of her pack's suited woman (not the
+baseline does (though that maps the bounding boxes alone) but only where a
+relative is near: Quaternius' casual woman takes the joints, names and
+hierarchy of her pack's suited woman (not the
 bones' rolls, which the library does not keep), so animations made for the
 pack retarget onto her by name.
 """
@@ -55,7 +56,7 @@ from ..types import Mesh, Skeleton
 from .nearest_character import SURFACE_POINTS, surface_points
 from .networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from .networks.trained import TRAINED_FOLDER
-from .surface_fit import AxisMap, fitted_axis_map
+from .surface_fit import AxisMap, bounding_box, fitted_axis_map
 from .symmetry import mirror_points
 
 #: The shipped library.
@@ -243,12 +244,14 @@ def library_points(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class ClosestRig:
     """The library entry nearest a character: its name, the surface distance,
-    and its key joints mapped onto the character (normalised frame), the
-    ones its rig has only."""
+    its key joints mapped onto the character (normalised frame), the
+    ones its rig has only, and the map that took them there
+    (:func:`entry_map`)."""
 
     name: str
     distance: float
     points: dict
+    axis_map: AxisMap
 
     @property
     def note(self) -> str:
@@ -333,9 +336,10 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     if found is None:
         return None
     best, distance = found
-    mapped = entry_map(library, best, surface)(library.key_joints[best])
+    axis_map = entry_map(library, best, surface)
+    mapped = axis_map(library.key_joints[best])
     points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
-    return ClosestRig(str(library.names[best]), distance, points)
+    return ClosestRig(str(library.names[best]), distance, points, axis_map)
 
 
 def entry_map(library: RigLibrary, entry: int, surface: Mesh) -> AxisMap:
@@ -344,13 +348,15 @@ def entry_map(library: RigLibrary, entry: int, surface: Mesh) -> AxisMap:
     two surfaces (:func:`.surface_fit.fitted_axis_map`)."""
     return fitted_axis_map(library.points[entry], library.boxes[entry],
                            surface_points(surface.vertices, surface.triangles, SURFACE_POINTS),
-                           np.array([surface.vertices.min(axis=0), surface.vertices.max(axis=0)]))
+                           bounding_box(surface.vertices))
 
 
-def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | None = None) -> KnownRig | None:
+def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | None = None,
+               axis_map: AxisMap | None = None) -> KnownRig | None:
     """The rig of the entry ``name`` (found ``distance`` from ``surface``,
     normalised frame) mapped onto it as its key joints are
-    (:func:`closest_rig`, :func:`entry_map`); None when
+    (:func:`closest_rig`, :func:`entry_map`; ``axis_map``: that map when the
+    caller has it already, :attr:`ClosestRig.axis_map`); None when
     that is farther than :data:`LIBRARY_DISTANCE` or the entry keeps no rig."""
     library = shipped_library() if library is None else library
     if library is None or distance > LIBRARY_DISTANCE:
@@ -360,7 +366,7 @@ def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | 
         return None
     entry = int(found[0])
     rows = library.rig_rows(entry)
-    fitted = entry_map(library, entry, surface)
+    fitted = entry_map(library, entry, surface) if axis_map is None else axis_map
     joints, tails = fitted(library.rig_joints[rows]), fitted(library.rig_tails[rows])
     skeleton = Skeleton(joints, library.rig_parents[rows].copy(), tuple(str(bone) for bone in library.rig_names[rows]),
                         tails, library.rig_deform[rows].copy())

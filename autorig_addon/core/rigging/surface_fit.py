@@ -19,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..evaluation.skeleton_metrics import symmetric_chamfer
+
 #: Rounds of iterative closest points. Measured on the 235 training
 #: characters with a known relative within the library's limit, each with
 #: itself and its near-duplicates out of the library (2026-12-07): the
@@ -63,10 +65,10 @@ def box_axis_map(source_box, target_box) -> AxisMap:
     return AxisMap(scale, shift)
 
 
-def surface_gap(points: np.ndarray, target_points: np.ndarray, target_tree: cKDTree | None = None) -> float:
-    """The mean distance from each point of one set to the other's nearest, both ways, halved."""
-    target_tree = cKDTree(target_points) if target_tree is None else target_tree
-    return 0.5 * float(target_tree.query(points)[0].mean() + cKDTree(points).query(target_points)[0].mean())
+def bounding_box(vertices: np.ndarray) -> np.ndarray:
+    """(2, 3): the lowest and the highest corner of ``vertices`` (n, 3)."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
 
 
 def fitted_axis_map(source_points: np.ndarray, source_box, target_points: np.ndarray, target_box) -> AxisMap:
@@ -83,7 +85,7 @@ def fitted_axis_map(source_points: np.ndarray, source_box, target_points: np.nda
     point of either set paired with the other's nearest; per axis, the
     least-squares scale and shift of those pairs), or the boxes' map itself
     unless the refined one brings the surfaces :data:`MIN_GAIN` closer
-    (:func:`surface_gap`) with every scale positive.
+    (their symmetric Chamfer distance) with every scale positive.
     """
     source = np.asarray(source_points, dtype=np.float64)
     target = np.asarray(target_points, dtype=np.float64)
@@ -105,7 +107,7 @@ def fitted_axis_map(source_points: np.ndarray, source_box, target_points: np.nda
             design = np.stack([paired_source[:, axis], np.ones(len(paired_source))], axis=1)
             (scale[axis], shift[axis]), *_ = np.linalg.lstsq(design, paired_target[:, axis], rcond=None)
     refined = AxisMap(scale, shift)
-    if np.all(scale > 0.0) and surface_gap(refined(source), target, tree) < (1.0 - MIN_GAIN) * surface_gap(
-            start(source), target, tree):
+    if np.all(scale > 0.0) and symmetric_chamfer(target, refined(source), tree) < (1.0 - MIN_GAIN) * symmetric_chamfer(
+            target, start(source), tree):
         return refined
     return start
