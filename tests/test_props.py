@@ -6,7 +6,7 @@ import pytest
 
 from autorig_addon.core.geometry.normals import vertex_normals
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging.props import carried_props, held_note, holding_bone, prop_notes, rigid_props
+from autorig_addon.core.rigging.props import GRIP_TIE, carried_props, held_note, holding_bone, prop_notes, rigid_props
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh, cylinder
 
@@ -220,3 +220,18 @@ def test_the_holding_bone_is_the_nearest_deform_segment():
     assert holding_bone(np.array([0.35, 0.0, 0.6]), skeleton) == "upper"
     assert holding_bone(np.array([0.1, 0.0, 0.2]), skeleton) == "lower"
     assert held_note("hand.R") == "held: bound wholly to bone 'hand.R' (a rigid prop, left out of the skeleton)"
+
+
+def test_a_grip_where_the_forearm_ends_and_the_hand_begins_is_in_the_hand():
+    """A forearm along +x from 0 to 0.25 and a hand from 0.25 to 0.33 (the skeleton 0.33 long): a grip 6 mm off the
+    wrist, a hair nearer the forearm's segment, is held by the hand; one a forearm's tenth back by the forearm."""
+    skeleton = Skeleton(np.array([[0.0, 0, 0], [0.25, 0, 0]]), np.array([-1, 0]), ("forearm", "hand"),
+                        np.array([[0.25, 0, 0], [0.33, 0, 0]]), np.array([True, True]))
+    assert GRIP_TIE == 0.01
+    near_wrist = np.array([0.2499, 0.006, 0.0])
+    assert holding_bone(near_wrist, skeleton) == "hand"
+    assert holding_bone(np.array([0.225, 0.006, 0.0]), skeleton) == "forearm"
+    # On the forearm's line 0.003 behind the wrist, within the tie (0.01 of 0.33): still the hand; 0.005 behind, the
+    # forearm.
+    assert holding_bone(np.array([0.247, 0.0, 0.0]), skeleton) == "hand"
+    assert holding_bone(np.array([0.245, 0.0, 0.0]), skeleton) == "forearm"

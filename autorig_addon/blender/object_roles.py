@@ -108,9 +108,10 @@ def carried_on_bones(objects: list) -> dict:
     """The objects of ``objects`` an armature carries on one bone (parented
     to it, no Armature modifier) while it deforms another of ``objects``:
     the props of the artist's own rig (KayKit's weapons on their hand slots),
-    each mapped to the head of its bone at rest, world space (a hand slot's
-    lies in the palm). A rig made of parts on bones alone (a robot) deforms
-    none of them and carries no props."""
+    each mapped to the middle of its bone at rest, world space (a hand slot
+    lies in the palm; a hand bone's middle is in the hand, where its head, at
+    the wrist, may lie as near the new forearm). A rig made of parts on bones
+    alone (a robot) deforms none of them and carries no props."""
     import numpy as np
 
     deforming = {modifier.object for obj in objects for modifier in obj.modifiers
@@ -121,8 +122,9 @@ def carried_on_bones(objects: list) -> dict:
         if bone is None or obj.parent not in deforming or bone not in obj.parent.data.bones or \
                 any(modifier.type == "ARMATURE" for modifier in obj.modifiers):
             continue
-        head = obj.parent.matrix_world @ obj.parent.data.bones[bone].head_local
-        carried[obj] = np.array(head, dtype=np.float64)
+        rest_bone = obj.parent.data.bones[bone]
+        middle = obj.parent.matrix_world @ ((rest_bone.head_local + rest_bone.tail_local) / 2.0)
+        carried[obj] = np.array(middle, dtype=np.float64)
     return carried
 
 

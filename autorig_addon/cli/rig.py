@@ -71,7 +71,7 @@ def clear_armatures(replace: bool) -> tuple[list[str], dict]:
     names : the names of the removed armatures
     carried : dict mapping each mesh an armature that deformed other meshes
         carried on one bone (KayKit's weapons, shields, helmet, cape) to that
-        bone's head at rest, world space (``blender.object_roles.carried_on_bones``):
+        bone's middle at rest, world space (``blender.object_roles.carried_on_bones``):
         ``plan_rig``'s ``carried``
     """
     import bpy

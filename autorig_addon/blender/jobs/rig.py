@@ -300,7 +300,7 @@ def plan_rig_steps(meshes: list, depsgraph, name: str, settings: RigSettings = R
     replace : bool
     named, rigify, keep_poor : bool, see :class:`RigPlan`
     carried : dict or None, mapping meshes a replaced armature carried on one bone each (KayKit's
-        weapons on their hand slots) to that bone's head at rest (world space): those sticking out of the
+        weapons on their hand slots) to that bone's middle at rest (world space): those sticking out of the
         rest are held props (``core.rigging.props.carried_props``), a mirrored pair too. The ``rig``
         command's ``--replace`` reads it before removing the armatures; with ``replace`` and ``skin``
         (Auto-Rig's Replace Binding) and none given, it is read from ``meshes``

@@ -69,7 +69,7 @@ from scipy.spatial import cKDTree
 from ..geometry.bounding_box import largest_side
 from ..geometry.closest_point import TriangleMeshQuery
 from ..geometry.normals import triangle_double_areas
-from ..geometry.segments import closest_segments
+from ..geometry.segments import point_segment_distances
 from ..geometry.topology import connected_component_labels
 from ..geometry.weld import seam_tolerance, weld_vertices
 from ..types import Mesh, Skeleton
@@ -226,7 +226,7 @@ def carried_props(mesh: Mesh, carried: dict) -> tuple[Prop, ...]:
     ----------
     mesh : Mesh, world space, one or more objects
     carried : dict mapping an object index to the (3,) world point of the bone
-        that carried it (its head at rest)
+        that carried it (its middle at rest)
 
     Returns
     -------
@@ -415,14 +415,30 @@ def _mirrored(points: np.ndarray, axis: int, centre: float) -> np.ndarray:
     return mirrored
 
 
+#: Bone segments at most this much farther from a prop's grip than the nearest (share of the skeleton's largest
+#: side) hold it as well as the nearest (:func:`holding_bone`).
+GRIP_TIE = 0.01
+
+
 def holding_bone(grip: np.ndarray, skeleton: Skeleton) -> str:
     """The deform bone holding a prop: the one whose segment (head to tail)
     lies nearest to its ``grip`` (3,) (a sword's grip in the fist: the hand;
-    with Rigify's rig, its DEF- bone). ``skeleton`` needs a deform bone."""
+    with Rigify's rig, its DEF- bone). Of segments as near within
+    :data:`GRIP_TIE`, the one the grip lies nearest the head of: a grip
+    where the forearm ends and the hand begins is in the hand, which turns it
+    with the wrist (a wrist read a centimetre nearer the fingers, as a
+    longer-trained landmark network reads the procedural biped's, left its
+    sword on the forearm). ``skeleton`` needs a deform bone."""
     deform = np.flatnonzero(skeleton.deform)
-    index, _ = closest_segments(np.asarray(grip, dtype=np.float64)[None], skeleton.joints[deform],
-                                skeleton.tails[deform])
-    return skeleton.names[deform[int(index[0])]]
+    grip = np.asarray(grip, dtype=np.float64)
+    heads, tails = skeleton.joints[deform], skeleton.tails[deform]
+    distances = point_segment_distances(grip[None], heads, tails)[0]
+    extent = np.ptp(np.concatenate([skeleton.joints, skeleton.tails]), axis=0).max()
+    near = np.flatnonzero(distances <= distances.min() + GRIP_TIE * extent)
+    along = np.einsum("ij,ij->i", grip - heads[near], tails[near] - heads[near])
+    lengths = np.einsum("ij,ij->i", tails[near] - heads[near], tails[near] - heads[near])
+    shares = np.where(lengths > 0.0, along / np.where(lengths > 0.0, lengths, 1.0), 0.0)
+    return skeleton.names[deform[int(near[np.argmin(np.clip(shares, 0.0, 1.0))])]]
 
 
 # --------------------------------------------------------------------------- wording
