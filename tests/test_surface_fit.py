@@ -5,9 +5,10 @@ lacks moves a side of its box."""
 import numpy as np
 
 from autorig_addon.core.evaluation.skeleton_metrics import symmetric_chamfer
+from autorig_addon.core.geometry.bounding_box import bounding_box
 from autorig_addon.core.rigging.nearest_character import SURFACE_POINTS, surface_points
 from autorig_addon.core.rigging.rig_library import build_rig_library, closest_rig, fitted_rig
-from autorig_addon.core.rigging.surface_fit import MIN_GAIN, AxisMap, bounding_box, box_axis_map, fitted_axis_map
+from autorig_addon.core.rigging.surface_fit import MIN_GAIN, AxisMap, box_axis_map, fitted_axis_map
 from autorig_addon.core.skeleton.key_joints import KEY_JOINTS
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh, procedural_of_kind

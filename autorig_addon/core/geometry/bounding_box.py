@@ -1,5 +1,5 @@
-"""The size of a point set: the diagonal of its axis-aligned bounding box,
-or its largest side.
+"""The axis-aligned bounding box of a point set (:func:`bounding_box`) and
+its size: the diagonal, or its largest side.
 
 Every length the add-on scales by the size of a character (error
 measures, tolerances, weld distances) uses the diagonal, except where a
@@ -12,6 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+
+
+def bounding_box(vertices: np.ndarray) -> np.ndarray:
+    """(2, 3): the lowest and the highest corner of ``vertices`` (n, 3)."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
 
 
 def bounding_box_diagonal(points: np.ndarray) -> float:

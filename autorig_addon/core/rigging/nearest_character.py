@@ -30,9 +30,10 @@ from ..dataset.normalise import apply_transform, normalisation_transform
 from ..dataset.sample import CharacterSample
 from ..errors import InputError
 from ..evaluation.skeleton_metrics import symmetric_chamfer
+from ..geometry.bounding_box import bounding_box
 from ..geometry.normals import triangle_double_areas
 from ..types import Mesh, Skeleton
-from .surface_fit import bounding_box, box_axis_map
+from .surface_fit import box_axis_map
 
 #: Points drawn on each normalised surface for the Chamfer distance. On a
 #: character of largest side 1, 2,000 points are about 2 cm apart on a

@@ -50,13 +50,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..evaluation.skeleton_metrics import symmetric_chamfer
+from ..geometry.bounding_box import bounding_box
 from ..skeleton.hierarchy import ancestors, parents_first_order, reindexed_parents, subset_parents
 from ..skeleton.key_joints import KEY_JOINT_TWINS, KEY_JOINTS
 from ..types import Mesh, Skeleton
 from .nearest_character import SURFACE_POINTS, surface_points
 from .networks.landmarks import BODY_KINDS, STANDARD_KINDS, sample_landmarks
 from .networks.trained import TRAINED_FOLDER
-from .surface_fit import AxisMap, bounding_box, fitted_axis_map
+from .surface_fit import AxisMap, fitted_axis_map
 from .symmetry import mirror_points
 
 #: The shipped library.

@@ -65,12 +65,6 @@ def box_axis_map(source_box, target_box) -> AxisMap:
     return AxisMap(scale, shift)
 
 
-def bounding_box(vertices: np.ndarray) -> np.ndarray:
-    """(2, 3): the lowest and the highest corner of ``vertices`` (n, 3)."""
-    vertices = np.asarray(vertices, dtype=np.float64)
-    return np.array([vertices.min(axis=0), vertices.max(axis=0)])
-
-
 def fitted_axis_map(source_points: np.ndarray, source_box, target_points: np.ndarray, target_box) -> AxisMap:
     """The per-axis map taking a known body onto a character.
 
