@@ -31,7 +31,7 @@ def main(folder: str) -> int:
         skeleton = merge_coincident_joints(sample.skeleton.deform_subset(), COINCIDENT_JOINT_FRACTION)
         # An artist's deform bones alone are often several trees once the helpers between them go: that check
         # is for predictions, which are one tree by construction.
-        problems = [problem for problem in skeleton_problems(skeleton, solid_depth(sample.mesh).at, sample.vertices,
+        problems = [problem for problem in skeleton_problems(skeleton, solid_depth(sample.mesh).at, sample.mesh,
                                                              enclosed_by(sample.mesh))
                     if "separate trees" not in problem]
         total += 1

@@ -6,10 +6,10 @@ from autorig_addon.core.rigging.quality import FAR_FROM_SURFACE, enclosed_by, sk
 from autorig_addon.core.types import Mesh, Skeleton
 from geometry_fixtures import box_mesh
 
-#: A body: the box |x| <= 0.2, |y| <= 0.1, 0 <= z <= 1, its surface sampled on a grid.
+#: A body: the box |x| <= 0.2, |y| <= 0.1, 0 <= z <= 1, its surface sampled on a grid (points, no triangles).
 LOW, HIGH = np.array([-0.2, -0.1, 0.0]), np.array([0.2, 0.1, 1.0])
 GRID = np.stack(np.meshgrid(*[np.linspace(a, b, 9) for a, b in zip(LOW, HIGH)], indexing="ij"), -1).reshape(-1, 3)
-SURFACE = GRID[np.any(np.isclose(GRID, LOW) | np.isclose(GRID, HIGH), axis=1)]
+SURFACE = Mesh(GRID[np.any(np.isclose(GRID, LOW) | np.isclose(GRID, HIGH), axis=1)], np.zeros((0, 3)))
 
 
 def depth(points):
@@ -72,8 +72,25 @@ def test_bones_inside_an_open_mesh_whose_solid_is_a_shell_are_inside_the_body():
                      ("spine", "spine.001", "spine.002"))
     shell = lambda points: np.zeros(len(points))  # noqa: E731
     assert 0.4 > FAR_FROM_SURFACE
-    assert skeleton_problems(spine, shell, box.vertices) == ("spine, spine.001 lie mostly outside the body",)
-    assert skeleton_problems(spine, shell, box.vertices, enclosed_by(surface)) == ()
+    assert skeleton_problems(spine, shell, surface) == ("spine, spine.001 lie mostly outside the body",)
+    assert skeleton_problems(spine, shell, surface, enclosed_by(surface)) == ()
     leaving = Skeleton(np.array([[0.3, 0, 0.5], [1.25, 0, 0.5]]), np.array([-1, 0]), ("root", "tip"))
-    assert skeleton_problems(leaving, shell, box.vertices, enclosed_by(surface)) == (
+    assert skeleton_problems(leaving, shell, surface, enclosed_by(surface)) == (
         "root lies mostly outside the body",)
+
+
+def test_a_bone_along_a_big_face_of_a_low_poly_body_is_on_it():
+    """The 0 A.D. rabbit: 111 vertices, so a front leg running just outside a face lies 0.1 of the body from
+    every corner though 0.02 from the face. The distance that counts is the surface's (its triangles'): within
+    FAR_FROM_SURFACE of them the leg is on the body; the same leg 0.15 out is not."""
+    slab = box_mesh((-0.5, -0.5, 0.0), (0.5, 0.5, 0.1), 1.0)
+    shell = lambda points: np.zeros(len(points))  # noqa: E731
+    along = Skeleton(np.array([[-0.2, 0.0, 0.12], [0.2, 0.0, 0.12]]), np.array([-1, 0]), ("front_thigh.L", "shin"))
+    # Every point along the leg is farther than FAR_FROM_SURFACE from the slab's corners, 0.02 from its top.
+    corners = np.linalg.norm(np.linspace(along.joints[0], along.joints[1], 11)[:, None] - slab.vertices, axis=2)
+    assert corners.min() > FAR_FROM_SURFACE
+    assert skeleton_problems(along, shell, slab) == ()
+    assert skeleton_problems(along, shell, Mesh(slab.vertices, np.zeros((0, 3)))) == (
+        "front_thigh.L lies mostly outside the body",)
+    lifted = Skeleton(along.joints + [0.0, 0.0, 0.15], along.parents, along.names)
+    assert skeleton_problems(lifted, shell, slab) == ("front_thigh.L lies mostly outside the body",)

@@ -434,10 +434,11 @@ def skeleton_quality(votes: JointVotes, skeleton: Skeleton) -> tuple:
         return ()
     normalised = Skeleton(apply_transform(skeleton.joints, votes.transform), skeleton.parents, skeleton.names,
                           apply_transform(skeleton.tails, votes.transform))
-    # The proxy (2,000 vertices, the solid's own mesh) keeps the winding numbers' cost small on any mesh.
-    enclosed = (enclosed_by(Mesh(votes.proxy_vertices, votes.proxy_triangles))
-                if votes.proxy_triangles is not None else None)
-    return skeleton_problems(normalised, votes.solid.at, votes.proxy_vertices, enclosed)
+    # The proxy (2,000 vertices, the solid's own mesh) keeps the winding numbers' and the closest points' cost
+    # small on any mesh.
+    proxy = Mesh(votes.proxy_vertices, np.zeros((0, 3)) if votes.proxy_triangles is None else votes.proxy_triangles)
+    enclosed = enclosed_by(proxy) if len(proxy.triangles) else None
+    return skeleton_problems(normalised, votes.solid.at, proxy, enclosed)
 
 
 class CheckedSkeleton(NamedTuple):

@@ -8,7 +8,9 @@ reject at first sight:
 * a bone longer than the body;
 * bones lying mostly outside the body (more than :data:`MAX_OUTSIDE_SHARE`
   of the points from a joint to a child joint where the solid has no depth,
-  the surface is farther than :data:`FAR_FROM_SURFACE` and, when the caller
+  the surface (its triangles, not only its corners: a low-poly animal's
+  vertices lie 0.1 of its length apart) is farther than
+  :data:`FAR_FROM_SURFACE` and, when the caller
   can tell, the surface does not enclose them: an open mesh's solid is only
   its shell; a leaf's tail, only an estimate, is not checked);
 * for a body named as a biped or quadruped (Rigify's role names, or an
@@ -26,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..geometry.closest_point import TriangleMeshQuery
 from ..geometry.winding import winding_numbers
 from ..skeleton.hierarchy import ancestors
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names
@@ -58,7 +61,14 @@ def _meeting_joint(parents: np.ndarray, first: int, second: int):
     return next((joint for joint in above_first if joint in above_second), None)
 
 
-def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray, enclosed=None) -> tuple:
+def _surface_distances(surface: Mesh, points: np.ndarray) -> np.ndarray:
+    """(k,) distance of each point to ``surface``: to its triangles, or to its vertices when it has none."""
+    if len(surface.triangles):
+        return TriangleMeshQuery(surface.vertices, surface.triangles).closest(points).distances
+    return cKDTree(surface.vertices).query(points)[0]
+
+
+def skeleton_problems(skeleton: Skeleton, depth_at, surface: Mesh, enclosed=None) -> tuple:
     """What is wrong with ``skeleton`` (normalised frame), as sentences; empty when nothing is.
 
     Parameters
@@ -66,10 +76,11 @@ def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray, enclose
     skeleton : Skeleton in the normalised frame (largest side 1)
     depth_at : callable, ``(k, 3) points -> (k,) depth`` of the character's
         solid (``SolidDepth.at``); 0 outside the body
-    surface : (n, 3) array, points of the character's surface (its proxy's
-        vertices): a point outside the solid counts as outside the body only
-        when it is also farther than :data:`FAR_FROM_SURFACE` from them, since
-        an open shell (a dress, a cape, a helmet) has a solid one cell deep
+    surface : Mesh, the character's surface (its proxy): a point outside the
+        solid counts as outside the body only when it is also farther than
+        :data:`FAR_FROM_SURFACE` from it, since an open shell (a dress, a
+        cape, a helmet) has a solid one cell deep. Without triangles, its
+        vertices stand for it
     enclosed : callable or None, ``(k, 3) points -> (k,) bool``: whether the
         character's surface encloses each point (``enclosed_by``): a point it
         encloses is inside the body whatever the solid says (an open mesh,
@@ -90,7 +101,9 @@ def skeleton_problems(skeleton: Skeleton, depth_at, surface: np.ndarray, enclose
     starts, ends = skeleton.joints[parents[parents >= 0]], skeleton.joints[parents >= 0]
     along = starts[:, None, :] + steps[None, :, None] * (ends - starts)[:, None, :]
     points = along.reshape(-1, 3)
-    away = (np.asarray(depth_at(points)) <= 0.0) & (cKDTree(surface).query(points)[0] > FAR_FROM_SURFACE)
+    away = np.asarray(depth_at(points)) <= 0.0
+    if away.any():
+        away[away] = _surface_distances(surface, points[away]) > FAR_FROM_SURFACE
     if enclosed is not None and away.any():
         away[away] = ~np.asarray(enclosed(points[away]), dtype=bool)
     outside = away.reshape(len(starts), BONE_SAMPLES).mean(axis=1)
