@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from autorig_addon.core.procedural import generate_character
-from autorig_addon.core.rigging.fingers import FINGER_NAMES, NOT_SEPARABLE_NOTE, hand_fingers
+from autorig_addon.core.rigging.fingers import FINGER_NAMES, HAND_LENGTH_SHARE, NOT_SEPARABLE_NOTE, hand_fingers
 from autorig_addon.core.rigging.metarig import FINGER_RIG, PALM_RIG, PALM_START, finger_bones
 from autorig_addon.core.rigging.predict import predict_votes, skeleton_from_votes, template_notes
 from autorig_addon.core.skeleton.name_presets import PRESETS, preset_names
@@ -62,6 +62,20 @@ def test_a_hand_of_boxes_gives_five_fingers_of_three_bones_with_their_tips_and_k
         # Joints evenly spaced: the three bones are equally long on a straight finger.
         lengths = np.linalg.norm(np.diff(finger.points, axis=0), axis=1)
         assert np.ptp(lengths) < 0.003
+
+
+def test_long_fingers_past_a_forearm_read_short_are_found_to_their_tips():
+    """The landmarks may read a forearm short (here 0.13 of the box hand's 0.25): its hand, 0.18 long, then
+    reaches 1.4 forearm lengths past the wrist. The cuts go up to HAND_LENGTH_SHARE (1.5) forearm lengths, so
+    they pass the fingertips; cut at one forearm's length they ended 0.05 inside every finger."""
+    hand, known = box_hand()
+    short_elbow = np.array([-0.13, 0.0, 0.0])
+    assert 1.0 < 0.18 / 0.13 < HAND_LENGTH_SHARE
+    fingers = {finger.name: finger for finger in hand_fingers(hand.vertices, hand.triangles, short_elbow, WRIST)}
+    for name in ("f_index", "f_middle", "f_ring", "f_pinky"):
+        knuckle, tip = known[name]
+        assert np.linalg.norm(fingers[name].points[-1] - tip) < 0.002
+        assert np.linalg.norm(fingers[name].points[0] - knuckle) < 0.002
 
 
 def test_a_mitten_hand_has_no_separable_fingers():

@@ -55,8 +55,15 @@ MERGED_GROWTH = 1.6
 #: by this share of the hand's length is a thumb.
 THUMB_LEAD = 0.15
 #: The hand is looked for within this share of the forearm's length of the
-#: forearm's line beyond the wrist, and no farther than the forearm is long.
+#: forearm's line beyond the wrist, and no farther than
+#: :data:`HAND_LENGTH_SHARE` forearm lengths.
 HAND_RADIUS_SHARE = 0.35
+#: A human hand is shorter than its forearm, but the forearm the landmarks
+#: give may be read short (the box-fingered test biped's 0.091 against its
+#: 0.096 once the landmark runs are averaged), and then a cap at one forearm
+#: ended the cuts inside long fingers. On 115 humanoids' samples 1.5 found
+#: fingers on the same 8 whose artists rigged some and on one fewer without.
+HAND_LENGTH_SHARE = 1.5
 #: Pieces of a cut reaching farther than this share of the forearm's length
 #: from the hand's line are something else (a thigh beside a hanging hand).
 PIECE_RADIUS_SHARE = 0.5
@@ -104,12 +111,13 @@ def has_fingers(names) -> bool:
 def hand_extent(vertices: np.ndarray, wrist: np.ndarray, direction: np.ndarray, forearm_length: float) -> float | None:
     """How far the hand reaches past the wrist along ``direction`` (unit, (3,)):
     the farthest vertex within :data:`HAND_RADIUS_SHARE` of the forearm's
-    length of the line, capped at ``forearm_length``; None when no vertex lies past the wrist."""
+    length of the line, capped at :data:`HAND_LENGTH_SHARE` times ``forearm_length``; None when no vertex lies
+    past the wrist."""
     offsets = vertices - wrist
     along = offsets @ direction
     across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
     reach = along[(along > 0) & (across <= HAND_RADIUS_SHARE * forearm_length)]
-    return min(float(reach.max()), forearm_length) if len(reach) else None
+    return min(float(reach.max()), HAND_LENGTH_SHARE * forearm_length) if len(reach) else None
 
 
 @dataclass(frozen=True)
