@@ -2,6 +2,8 @@
 written once on them (aggregation, layers, convolution) against answers
 worked out by hand."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -148,6 +150,29 @@ def test_edge_convolution_on_a_hand_worked_graph():
     assert convolved(activate_last=False) == [[3], [-1], [0]]
     assert convolved(aggregation="mean", activate_last=False) == [[2], [-1], [0]]
     assert convolved(aggregation="min") == [[1], [0], [0]]
+
+
+@pytest.mark.parametrize("activation", sorted(NUMPY.activations))
+def test_a_max_aggregated_one_layer_edge_convolution_equals_its_per_edge_rows_to_the_last_bit(activation):
+    """numpy takes the largest of a receiver's messages ``f(a_i + b_j)`` as ``f(a_i + max_j b_j)`` (one
+    activation per node, not per edge); written per edge (the table under another name, as torch runs it)
+    the numbers are the same bit for bit: float32, senders with equal features (ties), nodes that receive
+    nothing."""
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(60, 8)).astype(np.float32)
+    x[10:14] = x[9]  # senders whose messages tie
+    edges = rng.integers(0, 50, size=(2, 400))  # nodes 50..59 receive nothing
+    edges[0, :20] = rng.integers(9, 14, size=20)
+    weights = {"conv.mlp.linears.0.weight": rng.normal(size=(16, 16)).astype(np.float32),
+               "conv.mlp.linears.0.bias": rng.normal(size=16).astype(np.float32)}
+    per_edge = dataclasses.replace(NUMPY, name="numpy, per edge")
+    for activate_last in (True, False):
+        fast = edge_convolution(NUMPY, weights, x, edges, "conv.", activation=activation, activate_last=activate_last)
+        rows = edge_convolution(per_edge, weights, x, edges, "conv.", activation=activation,
+                                activate_last=activate_last)
+        assert fast.dtype == rows.dtype == np.float32
+        assert np.array_equal(fast, rows)
+        assert not fast[50:].any() and fast[:50].any()
 
 
 def test_multi_aggregator_convolution_on_a_hand_worked_graph():

@@ -26,7 +26,7 @@ the same messages several ways. Their parameter layouts are
 from __future__ import annotations
 
 from .aggregation import aggregate
-from .layers import mlp
+from .layers import layer_count, mlp
 from .operations import Array, Operations
 
 #: The aggregators of SkinningNet's convolution.
@@ -42,14 +42,38 @@ def edge_messages(ops: Operations, x: Array, edges: Array) -> Array:
     return ops.concat([receivers, ops.gather(x, edges[0]) - receivers], 1)
 
 
+def _first_layer_per_node(ops: Operations, x: Array, weight: Array, bias) -> tuple:
+    """The first layer's two per-node terms, ``(A - B) x + bias`` and ``B x``
+    (see the module docstring): (n, c), (out, 2c), (out,) give two (n, out)."""
+    channels = x.shape[1]
+    receiver_weight, difference_weight = weight[:, :channels], weight[:, channels:]
+    return ops.linear(x, receiver_weight - difference_weight, bias), ops.linear(x, difference_weight, None)
+
+
 def first_layer_per_edge(ops: Operations, x: Array, edges: Array, weight: Array, bias) -> Array:
     """``linear(edge_messages(x, edges), weight, bias)`` computed per node
     then gathered: (n, c), (2, e), (out, 2c), (out,) give (e, out)."""
-    channels = x.shape[1]
-    receiver_weight, difference_weight = weight[:, :channels], weight[:, channels:]
-    at_receiver = ops.linear(x, receiver_weight - difference_weight, bias)
-    at_sender = ops.linear(x, difference_weight, None)
+    at_receiver, at_sender = _first_layer_per_node(ops, x, weight, bias)
     return ops.gather(at_receiver, edges[1]) + ops.gather(at_sender, edges[0])
+
+
+def _largest_one_layer_message(ops: Operations, params: dict, x: Array, edges: Array, prefix: str, *,
+                               activation: str, activate_last: bool) -> Array:
+    """(n, out): the max-aggregated messages of a one-layer EdgeConv MLP,
+    without a row per edge. A message is ``f(a_i + b_j)`` with ``a_i`` the
+    receiver's term, ``b_j`` the sender's and ``f`` an activation that never
+    decreases (all of ``ops.activations`` do), and adding ``a_i`` never
+    reorders two numbers, rounding included, so the largest message is
+    ``f(a_i + max_j b_j)``, to the last bit: one activation per node instead
+    of one per edge. A node that receives no edge gets 0, as the segment
+    max gives it."""
+    first = prefix + "mlp.linears.0."
+    at_receiver, at_sender = _first_layer_per_node(ops, x, params[first + "weight"], params.get(first + "bias"))
+    senders, receivers, count = edges[0], edges[1], x.shape[0]
+    largest = ops.segment_max(ops.gather(at_sender, senders), receivers, count)
+    received = ops.segment_max(ops.gather(at_sender[:, :1] * 0 + 1, senders), receivers, count) > 0
+    activate = ops.activations[activation] if activate_last else ops.activations["none"]
+    return ops.where(received, activate(at_receiver + largest), 0.0)
 
 
 def edge_messages_mlp(ops: Operations, params: dict, x: Array, edges: Array, prefix: str, *,
@@ -82,6 +106,11 @@ def edge_convolution(ops: Operations, params: dict, x: Array, edges: Array, pref
     -------
     (n, out) float array, the aggregated messages of each node.
     """
+    if aggregation == "max" and ops.name == "numpy" and layer_count(params, prefix + "mlp.") == 1:
+        # Inference only: training keeps the per-edge rows, so its gradients (a tie is split the same way)
+        # and its recorded runs stay as they were; the torch twins check the two agree.
+        return _largest_one_layer_message(ops, params, x, edges, prefix, activation=activation,
+                                          activate_last=activate_last)
     messages = edge_messages_mlp(ops, params, x, edges, prefix, activation=activation, activate_last=activate_last)
     return aggregate(ops, aggregation, messages, edges[1], x.shape[0])
 
