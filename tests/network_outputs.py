@@ -77,7 +77,7 @@ def skin_outputs() -> dict:
 
 def rig_outputs() -> dict:
     """The landmark network's ``landmarks.points`` (15, 3) and
-    ``landmarks.kind_logits`` (1, 3), the joint network's ``joints.offsets``
+    ``landmarks.kind_logits`` (1, 3), its longer run's ``landmarks_long.points``, the joint network's ``joints.offsets``
     (n, 3) and ``joints.attention`` (n,), the upright network's ``upright.probabilities`` (4,), then
     ``bones.probabilities`` and ``root.scores`` on the character's
     own joints (fixed inputs: joints a mean shift finds can move by more than
@@ -93,9 +93,11 @@ def rig_outputs() -> dict:
     mirror = np.full(len(found), -1)  # no twins: a fixed input is all this needs
     pairs = candidate_pairs(found)
     points, kind_logits = landmarks.SPEC.forward(NUMPY, shipped_weights(landmarks.SPEC).weights, graph)
+    longer, _ = landmarks.LONG_SPEC.forward(NUMPY, shipped_weights(landmarks.LONG_SPEC).weights, graph)
     return {
         "landmarks.points": np.asarray(points, dtype=np.float32),
         "landmarks.kind_logits": np.asarray(kind_logits, dtype=np.float32),
+        "landmarks_long.points": np.asarray(longer, dtype=np.float32),
         "joints.offsets": offsets.astype(np.float32),
         "joints.attention": sigmoid(logits).astype(np.float32),
         "bones.probabilities": bone_probabilities(pair_features(found, pairs, solid, mirror)).astype(np.float32),

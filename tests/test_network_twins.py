@@ -12,6 +12,7 @@ from autorig_addon.core.nn.numpy_kernels import NUMPY
 from autorig_addon.core.nn.spec import shipped_weights
 from autorig_addon.core.rigging.joint_features import VERTEX_FEATURES, JointGraph, joint_graph, solid_depth
 from autorig_addon.core.rigging.networks import RIG_NETWORKS
+from autorig_addon.core.rigging.networks.landmarks import LANDMARK_NETWORK_NAMES
 from autorig_addon.core.rigging.tree_features import (
     PAIR_FEATURES,
     ROOT_FEATURES,
@@ -87,7 +88,7 @@ def random_inputs(name, seed):
     if name in SKIN_NETWORKS:
         bone_count = (1, 3, 9)[seed % 3]
         return skin_graph(*random_skin_inputs(seed, 40 + bone_count, bone_count))
-    if name in ("joints", "landmarks"):
+    if name in ("joints", *LANDMARK_NETWORK_NAMES):
         return random_joint_graph(seed)
     columns = {"bones": PAIR_FEATURES, "root": ROOT_FEATURES, "upright": UP_FEATURE_COUNT}[name]
     return rng.normal(size=(300, columns)).astype(np.float32)
@@ -105,7 +106,7 @@ def procedural_inputs():
     joints = reference_skeleton(sample).joints
     inputs = {name: skin[spec.distance] for name, spec in SKIN_NETWORKS.items()}
     graph = joint_graph(sample.mesh, solid)
-    inputs.update(joints=graph, landmarks=graph,
+    inputs.update(joints=graph, **dict.fromkeys(LANDMARK_NETWORK_NAMES, graph),
                   bones=pair_features(joints, candidate_pairs(joints), solid, np.full(len(joints), -1)),
                   root=root_features(joints, solid),
                   upright=candidate_features(*area_centroids(sample.mesh.vertices, sample.mesh.triangles)).astype(

@@ -37,7 +37,7 @@ def test_every_skin_network_gives_its_recorded_candidates_and_weights(recorded):
 def test_the_skeleton_networks_give_their_recorded_outputs(recorded):
     now = rig_outputs()
     assert sorted(now) == ["bones.probabilities", "joints.attention", "joints.offsets", "landmarks.kind_logits",
-                           "landmarks.points", "root.scores", "upright.probabilities"]
+                           "landmarks.points", "landmarks_long.points", "root.scores", "upright.probabilities"]
     assert_same_arrays(now, recorded, OUTPUT_TOLERANCE)
 
 

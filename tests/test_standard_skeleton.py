@@ -8,11 +8,13 @@ from scipy.spatial import cKDTree
 
 from autorig_addon.core.dataset.normalise import normalise
 from autorig_addon.core.errors import InputError
+from autorig_addon.core.nn.numpy_kernels import NUMPY
+from autorig_addon.core.nn.spec import shipped_weights
 from autorig_addon.core.procedural import generate_character
 from autorig_addon.core.rigging import predict
-from autorig_addon.core.rigging.joint_features import solid_depth
+from autorig_addon.core.rigging.joint_features import joint_graph, solid_depth
 from autorig_addon.core.rigging.metarig import metarig_placement
-from autorig_addon.core.rigging.networks.landmarks import LANDMARKS
+from autorig_addon.core.rigging.networks.landmarks import LANDMARKS, LONG_SPEC, SPEC
 from autorig_addon.core.rigging.rig_library import KnownRelative, KnownRig
 from autorig_addon.core.rigging.standard_skeleton import (
     BIPED,
@@ -33,6 +35,7 @@ from autorig_addon.core.rigging.standard_skeleton import (
     hips_at_most_at_hip_joints,
     landmark_warnings,
     limb_mirror_error,
+    predict_landmarks,
     quadruped_skeleton,
     shoulders_on_arm_axes,
     standard_skeleton,
@@ -279,6 +282,23 @@ def test_auto_gives_the_free_form_skeleton_when_the_kinds_landmarks_are_out_of_o
     # The same landmarks in order: the standard skeletons.
     assert predict.chosen_template(votes_with(sure_biped))[0] == BIPED
     assert predict.chosen_template(votes_with(sure_quadruped))[0] == QUADRUPED
+
+
+def test_the_landmarks_are_the_mean_of_the_two_runs_and_the_kind_the_first_runs():
+    character = generate_character(0, "biped")
+    mesh = normalise(character.mesh, character.skeleton).mesh
+    graph = joint_graph(mesh, solid_depth(mesh))
+    first, logits = SPEC.forward(NUMPY, shipped_weights(SPEC).weights, graph)
+    longer, _ = LONG_SPEC.forward(NUMPY, shipped_weights(LONG_SPEC).weights, graph)
+    # Two runs that differ: each landmark of the mean lies halfway between theirs.
+    assert np.abs(np.asarray(first) - np.asarray(longer)).max() > 1e-3
+    landmarks = predict_landmarks(graph)
+    for index, name in enumerate(LANDMARKS):
+        np.testing.assert_allclose(landmarks.points[name], 0.5 * (first[index] + longer[index]), atol=1e-6)
+    logits = np.asarray(logits, dtype=np.float64).reshape(-1)
+    expected = np.exp(logits - logits.max()) / np.exp(logits - logits.max()).sum()
+    np.testing.assert_allclose([landmarks.kind_probabilities[kind] for kind in ("biped", "quadruped", "other")],
+                               expected, atol=1e-9)
 
 
 def test_an_unknown_template_is_refused():

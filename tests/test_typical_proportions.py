@@ -5,6 +5,7 @@ short-legged biped whose hip joints and a big-headed one whose neck the
 landmark network puts far too high at first, and hip joints read below the
 crotch raised to it."""
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -177,7 +178,11 @@ def test_a_short_legged_biped_is_read_again_and_its_hip_joints_come_down(monkeyp
     errors, notes = hip_joint_errors(mesh, truth)
     # Measured: 0.017 of the largest side with the second reading, 0.109 without.
     assert max(errors) < 0.05, errors
-    assert any(note.startswith("The legs are short (crotch at 18% of the height)") for note in notes), notes
+    # The note gives the crotch it measured on the mesh: the squashed crotch lies at 19.8 % of the height (the
+    # reading finds the legs' parting a little below it, 17 to 18 %).
+    shares = [int(found.group(1)) for found in (re.match(r"The legs are short \(crotch at (\d+)% of the height\)", note)
+                                                for note in notes) if found]
+    assert len(shares) == 1 and 15 <= shares[0] <= 20, notes
     # The first reading alone: neither reading again.
     monkeypatch.setattr(proportions, "HIP_ABOVE_CROTCH", np.inf)
     monkeypatch.setattr(proportions, "NECK_ABOVE_PINCH", np.inf)

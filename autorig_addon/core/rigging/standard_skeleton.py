@@ -150,10 +150,15 @@ class Landmarks:
         return self.points if copied is None else {**self.points, **copied.points}
 
 
-def predict_landmarks(graph: JointGraph, weights: dict | None = None) -> Landmarks:
-    """Run the landmark network on a normalised proxy's graph."""
-    weights = shipped_weights(landmark_network.SPEC).weights if weights is None else weights
-    points, logits = landmark_network.SPEC.forward(NUMPY, weights, graph)
+def predict_landmarks(graph: JointGraph) -> Landmarks:
+    """Run the landmark networks on a normalised proxy's graph: the
+    landmarks are the mean of the two shipped runs'
+    (:data:`.networks.landmarks.SPEC` and ``LONG_SPEC``), the kind of body
+    the first's, on whose readings the kind's thresholds and the facing cues
+    were chosen."""
+    points, logits = landmark_network.SPEC.forward(NUMPY, shipped_weights(landmark_network.SPEC).weights, graph)
+    longer, _ = landmark_network.LONG_SPEC.forward(NUMPY, shipped_weights(landmark_network.LONG_SPEC).weights, graph)
+    points = 0.5 * (np.asarray(points, dtype=np.float64) + np.asarray(longer, dtype=np.float64))
     logits = np.asarray(logits, dtype=np.float64).reshape(-1)
     probabilities = np.exp(logits - logits.max())
     probabilities /= probabilities.sum()

@@ -122,7 +122,7 @@ def start_from_joint_trunk(module: NetworkModule) -> None:
 def train_landmark_network(samples: dict, train: list, holdout: list, record: FitRecord) -> dict:
     """Train the landmark network (torch seeded by the caller); returns the kept weights."""
     rng = np.random.default_rng(record.seed)
-    spec = rig_network("landmarks")
+    spec = rig_network(record.network)  # either landmark network: they differ in their runs only
     module = NetworkModule(spec).to(record.device)
     start_from_joint_trunk(module)
     train_data = landmark_data(samples, train)

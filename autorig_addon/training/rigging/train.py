@@ -45,7 +45,7 @@ from ...core.nn.spec import NetworkSpec
 from ...core.rigging.connectivity import bone_probabilities, root_scores
 from ...core.rigging.joint_features import VERTEX_VECTORS, solid_depth
 from ...core.rigging.networks import rig_network
-from ...core.rigging.networks.landmarks import sample_landmarks
+from ...core.rigging.networks.landmarks import LANDMARK_NETWORK_NAMES, sample_landmarks
 from ...core.rigging.predict import DEFAULT_BANDWIDTH, DEFAULT_DENSITY_THRESHOLD, cluster_joints, graph_votes
 from ...core.rigging.symmetry import SYMMETRY_TOLERANCE, mirror_error, mirror_points, symmetric_joints
 from ...core.rigging.tree_features import candidate_pairs, pair_features, root_features
@@ -87,8 +87,8 @@ JITTER_COPIES = 4
 #: one family most.
 SCORED_PER_FAMILY = 2
 #: The held-out score each network's epoch is chosen by (lower is better).
-SCORE_NAMES = {"joints": "cd_j2j", "landmarks": "landmark_error", "bones": "cross_entropy",
-               "root": "cross_entropy", "upright": "cross_entropy"}
+SCORE_NAMES = {"joints": "cd_j2j", "landmarks": "landmark_error", "landmarks_long": "landmark_error",
+               "bones": "cross_entropy", "root": "cross_entropy", "upright": "cross_entropy"}
 #: Networks trained full batch on a fixed family sample of characters.
 FULL_BATCH_NETWORKS = ("bones", "root")
 #: Epochs between progress lines (and history entries) of the full-batch networks.
@@ -283,7 +283,7 @@ def run_rig_training(network: str, *, sample_dir: Path, examples_dir: Optional[P
     record.details.update(train_examples=len(train), holdout=sorted(held_names), procedural=procedural)
     if network == "joints":
         weights = train_joint_network(train, holdout, record)
-    elif network == "landmarks":
+    elif network in LANDMARK_NETWORK_NAMES:
         # Other proportions (short legs, big heads) of the trained characters with key joints, as more copies of
         # each. Not of the rest: with every character reshaped, more validation bipeds were read as "other".
         trained_names = set(trained)

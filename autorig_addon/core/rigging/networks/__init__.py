@@ -10,7 +10,7 @@ from . import bones, joints, landmarks, root, upright
 #: Every skeleton network by name: the free-form skeleton's in the order
 #: they run, then the standard skeleton's, then the one that finds up.
 RIG_NETWORKS: dict[str, NetworkSpec] = {
-    spec.name: spec for spec in (joints.SPEC, bones.SPEC, root.SPEC, landmarks.SPEC, upright.SPEC)}
+    spec.name: spec for spec in (joints.SPEC, bones.SPEC, root.SPEC, landmarks.SPEC, landmarks.LONG_SPEC, upright.SPEC)}
 #: Names ``train rig --model`` accepts.
 NETWORK_NAMES = tuple(RIG_NETWORKS)
 
