@@ -349,24 +349,27 @@ def closest_rig(surface: Mesh, kind: str, library: RigLibrary | None = None,
     library = shipped_library() if library is None else library
     if library is None:
         return None
-    found = _nearest_entry(surface, library, np.flatnonzero((library.kinds == kind) & library.known.any(axis=1)),
+    # One draw of the surface's points serves the search and the fit (the same seed gives the same points).
+    drawn = surface_points(surface.vertices, surface.triangles, SURFACE_POINTS)
+    found = _nearest_entry(drawn, library, np.flatnonzero((library.kinds == kind) & library.known.any(axis=1)),
                            limit)
     if found is None:
         return None
     best, distance = found
-    axis_map = entry_map(library, best, surface)
+    axis_map = entry_map(library, best, surface, drawn)
     mapped = axis_map(library.key_joints[best])
     points = {name: mapped[index] for index, name in enumerate(KEY_JOINTS) if library.known[best, index]}
     return ClosestRig(str(library.names[best]), distance, points, axis_map)
 
 
-def entry_map(library: RigLibrary, entry: int, surface: Mesh) -> AxisMap:
+def entry_map(library: RigLibrary, entry: int, surface: Mesh, drawn: np.ndarray | None = None) -> AxisMap:
     """The per-axis map taking entry ``entry``'s body onto ``surface``
     (normalised frame): its bounding box onto the surface's, refined on the
-    two surfaces (:func:`.surface_fit.fitted_axis_map`)."""
-    return fitted_axis_map(library.points[entry], library.boxes[entry],
-                           surface_points(surface.vertices, surface.triangles, SURFACE_POINTS),
-                           bounding_box(surface.vertices))
+    two surfaces (:func:`.surface_fit.fitted_axis_map`). ``drawn``: the
+    surface's :data:`SURFACE_POINTS` points when the caller has drawn them."""
+    if drawn is None:
+        drawn = surface_points(surface.vertices, surface.triangles, SURFACE_POINTS)
+    return fitted_axis_map(library.points[entry], library.boxes[entry], drawn, bounding_box(surface.vertices))
 
 
 def fitted_rig(name: str, distance: float, surface: Mesh, library: RigLibrary | None = None,
@@ -398,16 +401,18 @@ def nearest_known_body(surface: Mesh, library: RigLibrary | None = None,
     library = shipped_library() if library is None else library
     if library is None:
         return None
-    found = _nearest_entry(surface, library, np.arange(len(library.names)), limit)
+    found = _nearest_entry(surface_points(surface.vertices, surface.triangles, SURFACE_POINTS), library,
+                           np.arange(len(library.names)), limit)
     if found is None:
         return None
     best, distance = found
     return KnownRelative(str(library.names[best]), str(library.kinds[best]), distance)
 
 
-def _nearest_entry(surface: Mesh, library: RigLibrary, entries: np.ndarray, limit: float) -> tuple | None:
+def _nearest_entry(target: np.ndarray, library: RigLibrary, entries: np.ndarray, limit: float) -> tuple | None:
     """(index, distance) of the entry among ``entries`` whose surface is
-    nearest ``surface`` when at most ``limit`` away, else None.
+    nearest the surface drawn as ``target`` (its :data:`SURFACE_POINTS`
+    points) when at most ``limit`` away, else None.
 
     Measuring every entry in full would take about a second (162 bipeds;
     twice that over all 324 entries).
@@ -419,7 +424,6 @@ def _nearest_entry(surface: Mesh, library: RigLibrary, entries: np.ndarray, limi
     """
     if not len(entries):
         return None
-    target = surface_points(surface.vertices, surface.triangles, SURFACE_POINTS)
     target_tree = cKDTree(target)
     screened = target_tree.query(library.points[entries, :SCREEN_POINTS].reshape(-1, 3))[0]
     estimates = screened.reshape(len(entries), -1).mean(axis=1)
