@@ -4,7 +4,15 @@ blocky bodies built from boxes with the joints where an artist puts them."""
 import numpy as np
 import pytest
 
-from autorig_addon.core.rigging.body_layout import MIN_INSIDE_SHARE, MIN_TRUNK_RISE, SEGMENT_SAMPLES, biped_layout
+from autorig_addon.core.rigging.body_layout import (
+    MAX_FEET_LEVEL_GAP,
+    MIN_INSIDE_SHARE,
+    MIN_LEG_INSIDE_SHARE,
+    MIN_TRUNK_RISE,
+    SEGMENT_SAMPLES,
+    biped_layout,
+    quadruped_layout,
+)
 from autorig_addon.core.rigging.joint_features import solid_depth
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh
@@ -91,48 +99,124 @@ def test_a_trunk_leaning_more_than_it_rises_over_two_is_no_upright_biped():
     assert biped_layout(_both_sides({**CHIBI_JOINTS, "neck": [0.0, -0.16, 0.54]}), solid) is None
 
 
-def test_a_quadrupeds_trunk_lies_along_its_length():
-    # A four-legged box animal facing -y, with the biped landmarks a network gives it: the hips at its rump, the
-    # neck and head at its front, a leg pair each for the "arms" and "legs". Legs apart, all inside, in order from
-    # the top: only the trunk's run along y tells it is no biped.
-    legs = [([x0, y0, 0.0], [x0 + 0.1, y0 + 0.1, 0.3]) for x0 in (-0.15, 0.05) for y0 in (-0.4, 0.3)]
-    body = ([-0.15, -0.45, 0.3], [0.15, 0.45, 0.55])
-    head = ([-0.1, -0.6, 0.45], [0.1, -0.4, 0.7])
-    solid = solid_depth(_boxes(*legs, body, head))
-    points = _both_sides({
-        "hips": [0.0, 0.35, 0.42], "neck": [0.0, -0.4, 0.5], "head": [0.0, -0.5, 0.6],
-        "shoulder.L": [0.1, -0.35, 0.4], "elbow.L": [0.1, -0.35, 0.32], "wrist.L": [0.1, -0.35, 0.2],
-        "hip.L": [0.1, 0.35, 0.4], "knee.L": [0.1, 0.35, 0.2], "ankle.L": [0.1, 0.35, 0.05],
-    })
-    assert biped_layout(points, solid) is None
+#: A four-legged box animal facing -y, 0.7 tall: legs 0.3 long (each pair 0.1 apart), a body 0.9 long, a head
+#: standing up at its front.
+ANIMAL_LEGS = tuple(([x0, y0, 0.0], [x0 + 0.1, y0 + 0.1, 0.3]) for x0 in (-0.15, 0.05) for y0 in (-0.4, 0.3))
+ANIMAL_BODY = ([-0.15, -0.45, 0.3], [0.15, 0.45, 0.55])
+ANIMAL_HEAD = ([-0.1, -0.6, 0.45], [0.1, -0.4, 0.7])
+#: Its landmarks as the network gives a quadruped's: the hips at its rump, the neck and head at its front, the
+#: "arms" its front legs, the "legs" its hind legs.
+ANIMAL_JOINTS = {
+    "hips": [0.0, 0.35, 0.42], "neck": [0.0, -0.4, 0.5], "head": [0.0, -0.5, 0.6],
+    "shoulder.L": [0.1, -0.35, 0.4], "elbow.L": [0.1, -0.35, 0.32], "wrist.L": [0.1, -0.35, 0.2],
+    "hip.L": [0.1, 0.35, 0.4], "knee.L": [0.1, 0.35, 0.2], "ankle.L": [0.1, 0.35, 0.05],
+}
+
+
+@pytest.fixture(scope="module")
+def animal():
+    return solid_depth(_boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD))
+
+
+def test_a_quadrupeds_trunk_lies_along_its_length(animal):
+    # Legs apart, all inside, in order from the top: only the trunk's run along y tells it is no biped.
+    points = _both_sides(ANIMAL_JOINTS)
+    assert biped_layout(points, animal) is None
     # Stood up on its hind legs (the same landmarks with the neck above the hips) it would pass the trunk test: the
     # other tests are what they are, and the trunk is what failed.
     upright = dict(points, hips=np.array([0.0, 0.35, 0.35]), neck=np.array([0.0, 0.33, 0.5]),
                    head=np.array([0.0, 0.33, 0.52]))
-    assert biped_layout(upright, solid) is not None
+    assert biped_layout(upright, animal) is not None
+    assert quadruped_layout(upright, animal) is None
+
+
+def test_a_box_animal_with_its_joints_in_place_is_laid_out_as_a_quadruped(animal):
+    layout = quadruped_layout(_both_sides(ANIMAL_JOINTS), animal)
+    assert layout is not None and layout.kind == "quadruped"
+    assert layout.inside_share == 1.0
+    assert layout.note == ("its quadruped landmarks make a four-legged body (every leg and the trunk inside it, each "
+                           "pair of feet apart, the front and hind feet level, the trunk above them along the body's "
+                           "length), so it is taken for a quadruped")
+    # An upright chibi's landmarks are no quadruped: its trunk rises.
+    assert quadruped_layout(_both_sides(CHIBI_JOINTS), solid_depth(_boxes(*LEGS, TRUNK, HEAD, *ARMS))) is None
+
+
+def test_a_quadruped_facing_plus_y_or_with_its_feet_crossed_is_not_laid_out_as_one(animal):
+    points = _both_sides(ANIMAL_JOINTS)
+    # Read the wrong way round (the neck behind the hips, at +y): not a quadruped facing -y.
+    turned = {name: point * np.array([1.0, -1.0, 1.0]) for name, point in points.items()}
+    assert quadruped_layout(turned, animal) is None
+    # Front feet read behind the hind feet.
+    crossed = _both_sides({**ANIMAL_JOINTS, "wrist.L": [0.1, 0.45, 0.2]})
+    assert quadruped_layout(crossed, animal) is None
+    # A knee read below its ankle.
+    assert quadruped_layout(_both_sides({**ANIMAL_JOINTS, "knee.L": [0.1, 0.35, 0.02]}), animal) is None
+
+
+def _raptor(front_leg_bottom: float, elbow: float, wrist: float):
+    """A body on two hind legs 0.5 long (ankles at 0.05) with a trunk at 0.5 to 0.65 (hips at 0.57) and front legs
+    from the trunk down to ``front_leg_bottom``, and its landmarks with the front ``elbow`` and ``wrist`` at those
+    heights."""
+    front = tuple(([x0, -0.4, front_leg_bottom], [x0 + 0.1, -0.3, 0.55]) for x0 in (-0.15, 0.05))
+    hind = tuple(([x0, 0.3, 0.0], [x0 + 0.1, 0.4, 0.55]) for x0 in (-0.15, 0.05))
+    body = ([-0.15, -0.45, 0.5], [0.15, 0.45, 0.65])
+    solid = solid_depth(_boxes(*front, *hind, body, ([-0.1, -0.6, 0.6], [0.1, -0.4, 0.8])))
+    points = _both_sides({
+        "hips": [0.0, 0.35, 0.57], "neck": [0.0, -0.4, 0.6], "head": [0.0, -0.5, 0.7],
+        "shoulder.L": [0.1, -0.35, 0.52], "elbow.L": [0.1, -0.35, elbow], "wrist.L": [0.1, -0.35, wrist],
+        "hip.L": [0.1, 0.35, 0.5], "knee.L": [0.1, 0.35, 0.27], "ankle.L": [0.1, 0.35, 0.05],
+    })
+    return points, solid
+
+
+def test_front_feet_held_high_are_hands_not_legs():
+    # Short front legs ending 0.3 above the ground (a raptor's arms): the wrists 0.35 high, 0.30 above the ankles,
+    # the trunk 0.52 above them. 0.30 > 0.5 * 0.52: hands, not feet.
+    assert MAX_FEET_LEVEL_GAP == 0.5
+    assert quadruped_layout(*_raptor(0.3, 0.45, 0.35)) is None
+    # Front feet 0.25 high (0.20 above the ankles) stand on the ground with the hind ones, as far as the test goes.
+    assert quadruped_layout(*_raptor(0.2, 0.4, 0.25)) is not None
+    # Legs to the ground, as a quadruped's.
+    assert quadruped_layout(*_raptor(0.0, 0.3, 0.05)) is not None
+
+
+def test_a_quadrupeds_thin_legs_need_half_their_length_inside(animal):
+    # Hind ankles read behind the leg (its box ends at y = 0.4): the shin leaves it partway down. At y = 0.45, 6 of
+    # the shin's 11 points are inside: enough for a quadruped's thin leg, not for a biped's limb.
+    assert MIN_LEG_INSIDE_SHARE == 0.5 < 6 / 11 < MIN_INSIDE_SHARE
+    half = quadruped_layout(_both_sides({**ANIMAL_JOINTS, "ankle.L": [0.1, 0.45, 0.05]}), animal)
+    assert half is not None and half.inside_share == pytest.approx(6 / 11)
+    assert "every leg and the trunk at least 55% inside it" in half.note
+    # At y = 0.47, 5 of 11.
+    assert quadruped_layout(_both_sides({**ANIMAL_JOINTS, "ankle.L": [0.1, 0.47, 0.05]}), animal) is None
+    # Front feet in one column (a single block under the chest): no pair of legs.
+    column = ([-0.15, -0.4, 0.0], [0.15, -0.3, 0.3])
+    solid = solid_depth(_boxes(column, *ANIMAL_LEGS[1::2], ANIMAL_BODY, ANIMAL_HEAD))
+    assert quadruped_layout(_both_sides(ANIMAL_JOINTS), solid) is None
 
 
 OTHER_SURELY = {"biped": 0.05, "quadruped": 0.05, "other": 0.9}
 
 
-def _votes(monkeypatch, mesh, kind_probabilities, nearest=None):
+def _votes(monkeypatch, mesh, kind_probabilities, nearest=None, joints=CHIBI_JOINTS, body=None):
     """predict_votes on ``mesh`` with the landmark network's kind head reading
     ``kind_probabilities`` (as it reads Kenney's minis: "other") and its points
-    the chibi's joints, in the frame the graph is in (its box is the chibi's
-    box, scaled and moved), and ``nearest`` as the nearest known body."""
+    ``joints`` (default the chibi's) of ``body`` (default the chibi), in the
+    frame the graph is in (its box is the body's box, scaled and moved), and
+    ``nearest`` as the nearest known body."""
     from dataclasses import replace
 
     from autorig_addon.core.rigging import predict
 
-    chibi = _boxes(*LEGS, TRUNK, HEAD, *ARMS)
-    low, high = chibi.vertices.min(axis=0), chibi.vertices.max(axis=0)
+    body = _boxes(*LEGS, TRUNK, HEAD, *ARMS) if body is None else body
+    low, high = body.vertices.min(axis=0), body.vertices.max(axis=0)
     network = predict.predict_landmarks
 
     def read(graph):
         found = network(graph)
         box_low, box_high = graph.vertices.min(axis=0), graph.vertices.max(axis=0)
         points = {name: box_low + (point - low) / (high - low) * (box_high - box_low)
-                  for name, point in _both_sides(CHIBI_JOINTS).items()}
+                  for name, point in _both_sides(joints).items()}
         return replace(found, points={**found.points, **points}, kind_probabilities=kind_probabilities)
 
     monkeypatch.setattr(predict, "predict_landmarks", read)
@@ -194,3 +278,47 @@ def test_a_body_a_biped_by_its_layout_facing_plus_y_is_turned_by_its_toes(monkey
     found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
     # Facing +Y, its own left lies at -X.
     assert found["shoulder.L"][0] < -0.15 and found["shoulder.R"][0] > 0.15
+
+
+def test_a_body_read_as_other_laid_out_as_a_quadruped_gets_the_quadruped_skeleton(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+
+    mesh = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD)
+    votes = _votes(monkeypatch, mesh, OTHER_SURELY, joints=ANIMAL_JOINTS, body=mesh)
+    layout = votes.landmarks.layout
+    assert layout is not None and layout.kind == "quadruped" and votes.landmarks.kind_told_by is layout
+    kind, note = predict.chosen_template(votes, known_rig=False)
+    assert kind == "quadruped"
+    assert note.startswith("Template: standard quadruped skeleton; the landmark network reads the body as other (90% "
+                           "sure), not surely a biped or quadruped; its quadruped landmarks make a four-legged body")
+    skeleton = predict.skeleton_from_votes(votes, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    # Front legs take the arm roles and stand at the head end (-y), the hind legs' at the rump.
+    assert len(found) == 15
+    assert found["head"][1] < found["neck"][1] < found["hips"][1]
+    assert found["wrist.L"][1] < -0.25 and found["ankle.L"][1] > 0.25
+    assert found["shoulder.L"][0] > 0.0 and found["shoulder.R"][0] < 0.0
+    # Nothing but the layout tells its kind: without it, the free-form skeleton.
+    monkeypatch.setattr(predict, "quadruped_layout", lambda points, solid: None)
+    assert predict.chosen_template(predict.predict_votes(mesh))[0] == "free-form"
+
+
+def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_end(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+
+    # The box animal with a tail as long as its head reaches forward (its box is the same either way round), given
+    # facing +Y (turned half a turn): its head end, standing higher than its tail's, is at +y.
+    tail = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
+    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, tail)
+    mesh = type(facing_minus_y)(facing_minus_y.vertices * np.array([-1.0, -1.0, 1.0]), facing_minus_y.triangles)
+    votes = _votes(monkeypatch, mesh, OTHER_SURELY, joints=ANIMAL_JOINTS, body=facing_minus_y)
+    assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
+    assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
+            "prediction, so its .L bones lie on its own left.") in votes.notes
+    skeleton = predict.skeleton_from_votes(votes, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    # In the mesh's own space the head is at +y and, facing +Y, its own left lies at -X.
+    assert found["head"][1] > found["hips"][1] + 0.3
+    assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0

@@ -163,23 +163,56 @@ class Facing:
     front_untold: bool = False
 
 
-def front_untold_note(front: str, biped: bool = False) -> str:
+def front_untold_note(front: str, told_kind: str | None = None) -> str:
     """The report's note when nothing tells which way a body faces
     (``front``: the mesh-space axis it was taken to face, '-Y', '+X'...);
-    ``biped``: a body its nearest known body makes a biped, whose toes do
-    not tell either. Its shape alone does not: a linear score of the
+    ``told_kind``: the kind a body's nearest known body or its layout makes
+    it (biped, quadruped), whose shape cue (:func:`front_cue`) does not
+    tell either. Its shape alone does not: a linear score of the
     front-to-back profile (area, height, width and spread per band) told the
     front of 14 of the 23 validation fish, flyers and monsters
     (``scripts/check_front_profile.py``; docs/rigging.md, *Orientation*)."""
-    if biped:
+    if told_kind is not None:
+        cue = "its toes do not tell" if told_kind == BIPED else "neither end of it stands higher"
         return (f"Which way the character faces could not be told (the landmark network reads it as neither a biped "
-                f"nor a quadruped either way round, and its toes do not tell): it was taken to face {front} of its "
+                f"nor a quadruped either way round, and {cue}): it was taken to face {front} of its "
                 "own space, so its .L bones lie on its left seen so. If it faces another way, turn it to face -Y and "
                 "predict again.")
     return (f"Which way the character faces could not be told (it reads as neither a biped nor a quadruped, either "
             f"way round): it was taken to face {front} of its own space, so its .L bones lie on its left seen so, and "
             "a chain running away from that end is its tail. If it faces another way, turn it to face -Y and predict "
             "again.")
+
+
+@dataclass(frozen=True)
+class FrontCue:
+    """The shape's cue of which way a body faces (:func:`front_cue`).
+
+    Attributes
+    ----------
+    reach : float or None, positive when it faces -y; None when there is no cue
+    sure : float, the reach beyond which the cue tells
+    toward, that_way : str, the report's words for the end it faces ("its toes point toward" +Y; "its toes
+        point that way")
+    """
+
+    reach: float | None
+    sure: float
+    toward: str
+    that_way: str
+
+    @property
+    def tells(self) -> bool:
+        return self.reach is not None and abs(self.reach) > self.sure
+
+
+def front_cue(surface: Mesh, kind: str) -> FrontCue:
+    """The shape's cue of which way a body of ``kind`` faces: its toes
+    (:func:`toe_reach`, :data:`TOE_REACH_SURE`) for a biped, its head end
+    (:func:`head_end_rise`, :data:`HEAD_END_SURE`) for a quadruped."""
+    if kind == BIPED:
+        return FrontCue(toe_reach(surface), TOE_REACH_SURE, "its toes point toward", "its toes point that way")
+    return FrontCue(head_end_rise(surface), HEAD_END_SURE, "its head end is toward", "its head end is that way")
 
 
 def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
@@ -193,15 +226,9 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     """
     kinds = (landmarks.kind, turned.kind)
     surer_turned = standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN
-    shape, shape_kind = None, BIPED
-    if BIPED in kinds:
-        toes = toe_reach(surface)
-        if toes is not None and abs(toes) > TOE_REACH_SURE:
-            shape = (toes < 0.0, "its toes point toward", "its toes point that way")
-    elif QUADRUPED in kinds:
-        rise = head_end_rise(surface)
-        if rise is not None and abs(rise) > HEAD_END_SURE:
-            shape, shape_kind = (rise < 0.0, "its head end is toward", "its head end is that way"), QUADRUPED
+    shape_kind = BIPED if BIPED in kinds else QUADRUPED if QUADRUPED in kinds else None
+    cue = front_cue(surface, shape_kind) if shape_kind is not None else None
+    shape = (cue.reach < 0.0, cue.toward, cue.that_way) if cue is not None and cue.tells else None
     if shape is not None:
         backward, toward, that_way = shape
         if backward:

@@ -40,9 +40,9 @@ from ..progress import ProgressCallback, report
 from ..skeleton.name_presets import DEFAULT_PRESET, preset_names, preset_of
 from ..skeleton.tails import derived_tails
 from ..types import Mesh, Skeleton
-from .body_layout import BipedLayout, biped_layout
+from .body_layout import BodyLayout, biped_layout, quadruped_layout
 from .connectivity import bone_probabilities, oriented_tree, root_scores, spanning_tree
-from .facing import TOE_REACH_SURE, facing, from_behind, front_untold_note, half_turned, toe_reach
+from .facing import facing, from_behind, front_cue, front_untold_note, half_turned
 from .fingers import NOT_SEPARABLE_NOTE, has_fingers
 from .joint_features import PROXY_VERTICES, JointGraph, SolidDepth, joint_graph, solid_depth
 from .mean_shift import mean_shift_modes
@@ -260,19 +260,20 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     relative = _of_relative_kind(nearest)
     layout = _layout_of_untold_kind(landmarks, relative, solid)
     if way.front_untold and (relative is not None or layout is not None):
-        # Read as neither kind either way round, the body is a biped by its nearest known body or its layout: its
-        # toes tell its front.
-        toes = toe_reach(Mesh(graph.vertices, proxy.triangles))
-        if toes is not None and toes < -TOE_REACH_SURE:
+        # Read as neither kind either way round, the body is a biped or a quadruped by its nearest known body or its
+        # layout: its shape tells its front (a biped's toes, a quadruped's head end).
+        told_kind = (relative or layout).kind
+        cue = front_cue(Mesh(graph.vertices, proxy.triangles), told_kind)
+        if cue.tells and cue.reach < 0.0:
             rotation = HALF_TURN @ rotation
             transform, graph, solid, landmarks = read(rotation)
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
             nearest = nearest_known_body(normalised_surface)
             relative = _of_relative_kind(nearest)
             layout = _layout_of_untold_kind(landmarks, relative, solid)
-            notes.append(_turned_note("its toes point toward +Y"))
-        elif toes is None or toes <= TOE_REACH_SURE:
-            notes.append(front_untold_note(axis_name(-rotation[1]), biped=True))
+            notes.append(_turned_note(f"{cue.toward} +Y"))
+        elif not cue.tells:
+            notes.append(front_untold_note(axis_name(-rotation[1]), told_kind))
     elif way.front_untold:
         notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
     landmarks = replace(landmarks, relative=relative, layout=layout)
@@ -309,14 +310,14 @@ def _of_relative_kind(nearest: KnownRelative | None) -> KnownRelative | None:
 
 
 def _layout_of_untold_kind(landmarks: Landmarks, relative: KnownRelative | None,
-                           solid: SolidDepth) -> BipedLayout | None:
-    """The layout of a body's biped landmarks (:func:`.body_layout.biped_layout`)
-    when neither the landmark network (reading no kind surely) nor a known
-    ``relative`` (a biped near it, :func:`_of_relative_kind`) tells its kind;
-    else None."""
+                           solid: SolidDepth) -> BodyLayout | None:
+    """The layout of a body's landmarks as a biped's (:func:`.body_layout.biped_layout`), else as a
+    quadruped's (:func:`.body_layout.quadruped_layout`), when neither the landmark network (reading no kind
+    surely) nor a known ``relative`` (a biped near it, :func:`_of_relative_kind`) tells its kind; else None.
+    The two exclude each other: a biped's trunk rises, a quadruped's runs along its length."""
     if landmarks.read_surely or relative is not None:
         return None
-    return biped_layout(landmarks.points, solid)
+    return biped_layout(landmarks.points, solid) or quadruped_layout(landmarks.points, solid)
 
 
 def _read_again_at_typical_proportions(normalised: Mesh, solid: SolidDepth, landmarks: Landmarks,
@@ -374,8 +375,8 @@ def sure_standard_kind(landmarks: Landmarks) -> str | None:
     (:attr:`.standard_skeleton.Landmarks.standard_kind`): the kind the landmark
     network reads, when it is one with a standard skeleton read with at least
     :data:`.standard_skeleton.KIND_CONFIDENCE`, else its nearest known body's
-    (:data:`RELATIVE_KINDS`), else a biped when its landmarks are laid out as
-    one (:func:`.body_layout.biped_layout`); else None."""
+    (:data:`RELATIVE_KINDS`), else a biped or a quadruped when its landmarks
+    are laid out as one (:mod:`.body_layout`); else None."""
     return landmarks.standard_kind
 
 
@@ -507,8 +508,8 @@ def chosen_template(votes: JointVotes, template: str = DEFAULT_TEMPLATE, known_r
     else the landmark network's kind when it is a biped or a quadruped with
     probability at least :data:`.standard_skeleton.KIND_CONFIDENCE`, else
     the kind of the body's nearest known body when it gave one
-    (:data:`RELATIVE_KINDS`), else a biped when its landmarks are laid out
-    as one (:attr:`.standard_skeleton.Landmarks.layout`); but the free-form
+    (:data:`RELATIVE_KINDS`), else a biped or a quadruped when its landmarks
+    are laid out as one (:attr:`.standard_skeleton.Landmarks.layout`); but the free-form
     skeleton when that kind's landmarks are out of the order a standing body
     has them (:func:`.standard_skeleton.landmark_disorder`).
     """

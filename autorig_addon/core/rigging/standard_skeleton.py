@@ -47,7 +47,7 @@ from ..nn.spec import shipped_weights
 from ..skeleton.key_joints import LEFT, RIGHT
 from ..skeleton.naming import chain_names
 from ..types import Mesh, Skeleton
-from .body_layout import BipedLayout
+from .body_layout import BodyLayout
 from .fingers import FINGER_NAMES, Finger, finger_bone_names, hand_extent, hand_fingers
 from .joint_features import JointGraph, SolidDepth
 from .limb_sections import limb_joints_centred
@@ -95,15 +95,15 @@ class Landmarks:
         stand in for the network's (:mod:`.rig_library`); None when none lies near
     relative : KnownRelative, the nearest known body when it tells the kind the
         network does not read surely (:func:`.rig_library.nearest_known_body`); else None
-    layout : BipedLayout, the body's biped landmarks laid out as a biped's when
-        neither the network nor a known body tells the kind (:func:`.body_layout.biped_layout`); else None
+    layout : BodyLayout, the body's landmarks laid out as a biped's or a quadruped's when neither the
+        network nor a known body tells the kind (:mod:`.body_layout`); else None
     """
 
     points: dict
     kind_probabilities: dict
     closest_rig: ClosestRig | None = None
     relative: KnownRelative | None = None
-    layout: BipedLayout | None = None
+    layout: BodyLayout | None = None
 
     @property
     def kind(self) -> str:
@@ -123,13 +123,13 @@ class Landmarks:
     def standard_kind(self) -> str | None:
         """The kind of standard skeleton the body gets by default: the
         network's, when it reads one surely (:attr:`read_surely`); else its
-        known relative's; else a biped when its :attr:`layout` is one; else None."""
+        known relative's; else its :attr:`layout`'s kind; else None."""
         if self.read_surely:
             return self.kind
         return self.kind_told_by.kind if self.kind_told_by is not None else None
 
     @property
-    def kind_told_by(self) -> KnownRelative | BipedLayout | None:
+    def kind_told_by(self) -> KnownRelative | BodyLayout | None:
         """What tells the kind the network does not read surely: the known
         :attr:`relative`, else the :attr:`layout`; None when neither does (or
         the network reads it surely, which needs neither)."""
