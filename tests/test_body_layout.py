@@ -322,3 +322,48 @@ def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_en
     # In the mesh's own space the head is at +y and, facing +Y, its own left lies at -X.
     assert found["head"][1] > found["hips"][1] + 0.3
     assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0
+
+
+def test_a_quadruped_laid_out_only_read_the_other_way_round_is_turned_by_its_head_end(monkeypatch):
+    from dataclasses import replace
+
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.skeleton.key_joints import key_joints
+    from autorig_addon.core.skeleton.naming import mirror_name
+
+    # A reading that finds the head where it is: on the box animal given facing +Y, its landmarks (head at +y, left
+    # at -x) make no quadruped facing -y; read turned half a turn, they do.
+    tail = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
+    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, tail)
+    mesh = type(facing_minus_y)(facing_minus_y.vertices * np.array([-1.0, -1.0, 1.0]), facing_minus_y.triangles)
+    low, high = facing_minus_y.vertices.min(axis=0), facing_minus_y.vertices.max(axis=0)
+    network = predict.predict_landmarks
+
+    def read(graph):
+        found = network(graph)
+        vertices = graph.vertices
+        box_low, box_high = vertices.min(axis=0), vertices.max(axis=0)
+        length = box_high[1] - box_low[1]
+        # The higher end is the head's.
+        head_at_plus_y = (vertices[vertices[:, 1] > box_high[1] - 0.15 * length, 2].mean()
+                          > vertices[vertices[:, 1] < box_low[1] + 0.15 * length, 2].mean())
+        points = {}
+        for name, point in _both_sides(ANIMAL_JOINTS).items():
+            if head_at_plus_y:
+                name, point = mirror_name(name), point * np.array([-1.0, -1.0, 1.0])
+            points[name] = box_low + (point - low) / (high - low) * (box_high - box_low)
+        return replace(found, points={**found.points, **points}, kind_probabilities=OTHER_SURELY)
+
+    monkeypatch.setattr(predict, "predict_landmarks", read)
+    monkeypatch.setattr(predict, "nearest_known_body", lambda surface: None)
+    votes = predict.predict_votes(mesh)
+    assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
+    assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
+            "prediction, so its .L bones lie on its own left.") in votes.notes
+    skeleton = predict.skeleton_from_votes(votes, known_rig=False)
+    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
+    assert found["head"][1] > found["hips"][1] + 0.3
+    assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0
+    # Given facing -Y, it is read as it stands: no turn.
+    votes = predict.predict_votes(facing_minus_y)
+    assert votes.landmarks.layout.kind == "quadruped" and not any("turned half a turn" in n for n in votes.notes)

@@ -56,6 +56,7 @@ from .standard_skeleton import (
     BIPED,
     FREE_FORM,
     NEAR_SYMMETRIC_ERROR,
+    QUADRUPED,
     TEMPLATES,
     Landmarks,
     landmark_disorder,
@@ -259,12 +260,19 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
     nearest = None if sure_standard_kind(landmarks) else nearest_known_body(normalised_surface)
     relative = _of_relative_kind(nearest)
     layout = _layout_of_untold_kind(landmarks, relative, solid)
-    if way.front_untold and (relative is not None or layout is not None):
-        # Read as neither kind either way round, the body is a biped or a quadruped by its nearest known body or its
-        # layout: its shape tells its front (a biped's toes, a quadruped's head end).
-        told_kind = (relative or layout).kind
+    if way.front_untold:
+        # Read as neither kind either way round. A body a biped or a quadruped by its nearest known body or its layout
+        # has its front told by its shape (a biped's toes, a quadruped's head end); so has one whose landmarks make a
+        # quadruped only read the other way round, its head end toward +Y.
+        told = relative or layout
+        told_kind = told.kind if told is not None else QUADRUPED
         cue = front_cue(Mesh(graph.vertices, proxy.triangles), told_kind)
-        if cue.tells and cue.reach < 0.0:
+        faces_plus_y = cue.tells and cue.reach < 0.0
+        if faces_plus_y and told is None:
+            _, _, turned_solid, turned_landmarks = read(HALF_TURN @ rotation)
+            turned_layout = _layout_of_untold_kind(turned_landmarks, None, turned_solid)
+            faces_plus_y = turned_layout is not None and turned_layout.kind == QUADRUPED
+        if faces_plus_y:
             rotation = HALF_TURN @ rotation
             transform, graph, solid, landmarks = read(rotation)
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
@@ -272,10 +280,10 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
             relative = _of_relative_kind(nearest)
             layout = _layout_of_untold_kind(landmarks, relative, solid)
             notes.append(_turned_note(f"{cue.toward} +Y"))
+        elif told is None:
+            notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
         elif not cue.tells:
             notes.append(front_untold_note(axis_name(-rotation[1]), told_kind))
-    elif way.front_untold:
-        notes.append(front_untold_note(axis_name(-rotation[1])))  # the mesh-space direction the frame's -y is
     landmarks = replace(landmarks, relative=relative, layout=layout)
     landmarks, proportion_notes = _read_again_at_typical_proportions(Mesh(graph.vertices, proxy.triangles), solid,
                                                                      landmarks, way.read_from_behind)
