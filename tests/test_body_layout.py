@@ -14,6 +14,7 @@ from autorig_addon.core.rigging.body_layout import (
     quadruped_layout,
 )
 from autorig_addon.core.rigging.joint_features import solid_depth
+from autorig_addon.core.skeleton.naming import mirror_name
 from autorig_addon.core.types import Mesh
 from geometry_fixtures import box_mesh
 
@@ -146,8 +147,10 @@ def test_a_quadruped_facing_plus_y_or_with_its_feet_crossed_is_not_laid_out_as_o
     # Read the wrong way round (the neck behind the hips, at +y): not a quadruped facing -y.
     turned = {name: point * np.array([1.0, -1.0, 1.0]) for name, point in points.items()}
     assert quadruped_layout(turned, animal) is None
-    # Front feet read behind the hind feet.
-    crossed = _both_sides({**ANIMAL_JOINTS, "wrist.L": [0.1, 0.45, 0.2]})
+    # The front legs' landmarks on the hind legs and the hind legs' on the front legs: all inside, in order and level,
+    # but the front feet behind the hind feet.
+    crossed = {name: point * np.array([1.0, -1.0, 1.0]) if name not in ("hips", "neck", "head") else point
+               for name, point in points.items()}
     assert quadruped_layout(crossed, animal) is None
     # A knee read below its ankle.
     assert quadruped_layout(_both_sides({**ANIMAL_JOINTS, "knee.L": [0.1, 0.35, 0.02]}), animal) is None
@@ -198,12 +201,16 @@ def test_a_quadrupeds_thin_legs_need_half_their_length_inside(animal):
 OTHER_SURELY = {"biped": 0.05, "quadruped": 0.05, "other": 0.9}
 
 
-def _votes(monkeypatch, mesh, kind_probabilities, nearest=None, joints=CHIBI_JOINTS, body=None):
+def _votes(monkeypatch, mesh, kind_probabilities, nearest=None, joints=CHIBI_JOINTS, body=None, head_at=None):
     """predict_votes on ``mesh`` with the landmark network's kind head reading
     ``kind_probabilities`` (as it reads Kenney's minis: "other") and its points
     ``joints`` (default the chibi's) of ``body`` (default the chibi), in the
     frame the graph is in (its box is the body's box, scaled and moved), and
-    ``nearest`` as the nearest known body."""
+    ``nearest`` as the nearest known body. ``head_at``: None, the points as
+    given (their head toward -y) whichever way the graph faces; ``"head
+    end"``, a network that finds the head at the graph's higher end (its
+    points turned half a turn when that end is at +y); ``"tail end"``, one
+    that puts it at the lower end."""
     from dataclasses import replace
 
     from autorig_addon.core.rigging import predict
@@ -214,14 +221,26 @@ def _votes(monkeypatch, mesh, kind_probabilities, nearest=None, joints=CHIBI_JOI
 
     def read(graph):
         found = network(graph)
-        box_low, box_high = graph.vertices.min(axis=0), graph.vertices.max(axis=0)
-        points = {name: box_low + (point - low) / (high - low) * (box_high - box_low)
-                  for name, point in _both_sides(joints).items()}
+        vertices = graph.vertices
+        box_low, box_high = vertices.min(axis=0), vertices.max(axis=0)
+        given = _both_sides(joints)
+        if head_at is not None:
+            end = 0.15 * (box_high[1] - box_low[1])
+            higher_at_plus_y = (vertices[vertices[:, 1] > box_high[1] - end, 2].mean()
+                                > vertices[vertices[:, 1] < box_low[1] + end, 2].mean())
+            if higher_at_plus_y == (head_at == "head end"):
+                given = {mirror_name(name): point * np.array([-1.0, -1.0, 1.0]) for name, point in given.items()}
+        points = {name: box_low + (point - low) / (high - low) * (box_high - box_low) for name, point in given.items()}
         return replace(found, points={**found.points, **points}, kind_probabilities=kind_probabilities)
 
     monkeypatch.setattr(predict, "predict_landmarks", read)
     monkeypatch.setattr(predict, "nearest_known_body", lambda surface: nearest)
     return predict.predict_votes(mesh)
+
+
+def _half_turned(mesh: Mesh) -> Mesh:
+    """``mesh`` turned half a turn about z (facing +y if it faced -y)."""
+    return Mesh(mesh.vertices * np.array([-1.0, -1.0, 1.0]), mesh.triangles)
 
 
 def test_a_body_read_as_other_with_no_known_relative_is_a_biped_by_its_layout(monkeypatch):
@@ -304,15 +323,19 @@ def test_a_body_read_as_other_laid_out_as_a_quadruped_gets_the_quadruped_skeleto
     assert predict.chosen_template(predict.predict_votes(mesh))[0] == "free-form"
 
 
+#: The box animal with a tail as long as its head reaches forward: its box is the same either way round, and its head
+#: end stands higher than its tail's.
+TAIL = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
+
+
 def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_end(monkeypatch):
     from autorig_addon.core.rigging import predict
     from autorig_addon.core.skeleton.key_joints import key_joints
 
-    # The box animal with a tail as long as its head reaches forward (its box is the same either way round), given
-    # facing +Y (turned half a turn): its head end, standing higher than its tail's, is at +y.
-    tail = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
-    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, tail)
-    mesh = type(facing_minus_y)(facing_minus_y.vertices * np.array([-1.0, -1.0, 1.0]), facing_minus_y.triangles)
+    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, TAIL)
+    mesh = _half_turned(facing_minus_y)
+    # Read as given (facing +Y) or turned, the network lays it out as a quadruped facing -y: first with its head on the
+    # tail (its head end, toward +Y, turns it), then where it is.
     votes = _votes(monkeypatch, mesh, OTHER_SURELY, joints=ANIMAL_JOINTS, body=facing_minus_y)
     assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
     assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
@@ -325,38 +348,14 @@ def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_en
 
 
 def test_a_quadruped_laid_out_only_read_the_other_way_round_is_turned_by_its_head_end(monkeypatch):
-    from dataclasses import replace
-
     from autorig_addon.core.rigging import predict
     from autorig_addon.core.skeleton.key_joints import key_joints
-    from autorig_addon.core.skeleton.naming import mirror_name
 
-    # A reading that finds the head where it is: on the box animal given facing +Y, its landmarks (head at +y, left
-    # at -x) make no quadruped facing -y; read turned half a turn, they do.
-    tail = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
-    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, tail)
-    mesh = type(facing_minus_y)(facing_minus_y.vertices * np.array([-1.0, -1.0, 1.0]), facing_minus_y.triangles)
-    low, high = facing_minus_y.vertices.min(axis=0), facing_minus_y.vertices.max(axis=0)
-    network = predict.predict_landmarks
-
-    def read(graph):
-        found = network(graph)
-        vertices = graph.vertices
-        box_low, box_high = vertices.min(axis=0), vertices.max(axis=0)
-        length = box_high[1] - box_low[1]
-        # The higher end is the head's.
-        head_at_plus_y = (vertices[vertices[:, 1] > box_high[1] - 0.15 * length, 2].mean()
-                          > vertices[vertices[:, 1] < box_low[1] + 0.15 * length, 2].mean())
-        points = {}
-        for name, point in _both_sides(ANIMAL_JOINTS).items():
-            if head_at_plus_y:
-                name, point = mirror_name(name), point * np.array([-1.0, -1.0, 1.0])
-            points[name] = box_low + (point - low) / (high - low) * (box_high - box_low)
-        return replace(found, points={**found.points, **points}, kind_probabilities=OTHER_SURELY)
-
-    monkeypatch.setattr(predict, "predict_landmarks", read)
-    monkeypatch.setattr(predict, "nearest_known_body", lambda surface: None)
-    votes = predict.predict_votes(mesh)
+    # A network that finds the head where it is: on the box animal given facing +Y, its landmarks (head at +y) make no
+    # quadruped facing -y; read turned half a turn, they do.
+    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, TAIL)
+    votes = _votes(monkeypatch, _half_turned(facing_minus_y), OTHER_SURELY, joints=ANIMAL_JOINTS,
+                   body=facing_minus_y, head_at="head end")
     assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
     assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
             "prediction, so its .L bones lie on its own left.") in votes.notes
@@ -365,5 +364,35 @@ def test_a_quadruped_laid_out_only_read_the_other_way_round_is_turned_by_its_hea
     assert found["head"][1] > found["hips"][1] + 0.3
     assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0
     # Given facing -Y, it is read as it stands: no turn.
-    votes = predict.predict_votes(facing_minus_y)
+    votes = _votes(monkeypatch, facing_minus_y, OTHER_SURELY, joints=ANIMAL_JOINTS, body=facing_minus_y,
+                   head_at="head end")
     assert votes.landmarks.layout.kind == "quadruped" and not any("turned half a turn" in n for n in votes.notes)
+
+
+def test_a_quadruped_laid_out_with_its_head_on_its_tail_either_way_round_is_no_quadruped(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.rigging.facing import front_untold_note
+
+    # A network that puts the head at the lower end: given facing +Y, the landmarks make a quadruped facing -y with
+    # its head on the tail, and turned, another with its head on the tail. Its head end stands toward +Y, so the first
+    # is reversed and the second no better: neither is taken, and the body keeps the free-form skeleton.
+    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, TAIL)
+    votes = _votes(monkeypatch, _half_turned(facing_minus_y), OTHER_SURELY, joints=ANIMAL_JOINTS,
+                   body=facing_minus_y, head_at="tail end")
+    assert votes.landmarks.layout is None
+    assert not any("turned half a turn" in n for n in votes.notes)
+    assert front_untold_note("-Y") in votes.notes
+    assert predict.chosen_template(votes)[0] == "free-form"
+
+
+def test_a_quadruped_by_its_layout_whose_ends_stand_alike_is_taken_as_given_and_says_so(monkeypatch):
+    from autorig_addon.core.rigging import predict
+    from autorig_addon.core.rigging.facing import front_untold_note
+
+    # The box animal without head or tail: neither end stands higher, so nothing tells its front.
+    mesh = _boxes(*ANIMAL_LEGS, ANIMAL_BODY)
+    votes = _votes(monkeypatch, mesh, OTHER_SURELY, joints={**ANIMAL_JOINTS, "head": [0.0, -0.44, 0.5]}, body=mesh)
+    assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
+    note = front_untold_note("-Y", "quadruped")
+    assert "and neither end of it stands higher)" in note and note in votes.notes
+    assert predict.chosen_template(votes, known_rig=False)[0] == "quadruped"

@@ -31,11 +31,10 @@ than a free-form skeleton).
 Quadruped (2026-12-07, later; :data:`MIN_LEG_INSIDE_SHARE`,
 :data:`MAX_FEET_LEVEL_GAP`): 41 of the 51 training quadrupeds pass, and none
 of the 177 humanoids, 42 fish, 4 birds or 49 other bodies. Of these, only
-three pass every test but the legs' share inside: the shark (0 inside), the
-T. rex (0.09) and the velociraptor; the velociraptor's legs are inside, but
-its "front feet" are its hands, held 0.83 of the trunk's height above its
-feet (the quadrupeds' front and hind feet: 0.21 apart at the median, 0.41
-at most).
+three pass all tests but one: the shark and the T. rex fail the legs' share
+inside (0 and 0.09), the velociraptor the feet's level: its "front feet" are
+its hands, held 0.83 of the trunk's height above its feet (the quadrupeds'
+front and hind feet: 0.21 apart at the median, 0.41 at most).
 """
 
 from __future__ import annotations
@@ -69,11 +68,12 @@ SEGMENT_SAMPLES = 11
 MIN_INSIDE_SHARE = 0.6
 #: An upright trunk rises at least this many times as much as it runs front to back.
 MIN_TRUNK_RISE = 2.0
-#: Least share of a quadruped's leg bones and trunk inside the solid: half.
-#: Animals' legs are thin, a few cells of the solid across, so a bone read a
-#: little off the leg's axis leaves it sooner than a biped's thick limbs (the
-#: rat of Quaternius' enemies: 0.45); the training bodies that are not
-#: quadrupeds and pass every other test have legs at most 0.09 inside.
+#: Least share of a quadruped's leg bones and trunk inside the solid: half,
+#: looser than a biped's limbs. Animals' legs are thin, a few cells of the
+#: solid across, so a bone read a little off the leg's axis leaves it sooner
+#: (the rat of Quaternius' enemies, read as no kind, has a leg only 0.45
+#: inside and is still refused); the training bodies that are not quadrupeds
+#: and pass every other test have legs at most 0.09 inside.
 MIN_LEG_INSIDE_SHARE = 0.5
 #: A quadruped's trunk runs along its length (y) at least this many times as
 #: much as it rises or falls.
@@ -99,11 +99,10 @@ class BodyLayout:
 
     @property
     def note(self) -> str:
+        inside = "inside it" if self.inside_share >= 1.0 else f"at least {self.inside_share:.0%} inside it"
         if self.kind == BIPED:
-            inside = "inside it" if self.inside_share >= 1.0 else f"at least {self.inside_share:.0%} inside it"
             return (f"its biped landmarks make an upright body (every limb, the trunk and the neck {inside}, the legs "
                     "apart, the head on top), so it is taken for a biped")
-        inside = "inside it" if self.inside_share >= 1.0 else f"at least {self.inside_share:.0%} inside it"
         return (f"its quadruped landmarks make a four-legged body (every leg and the trunk {inside}, each pair of "
                 "feet apart, the front and hind feet level, the trunk above them along the body's length), so it is "
                 "taken for a quadruped")

@@ -268,15 +268,25 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         told_kind = told.kind if told is not None else QUADRUPED
         cue = front_cue(Mesh(graph.vertices, proxy.triangles), told_kind)
         faces_plus_y = cue.tells and cue.reach < 0.0
-        if faces_plus_y and told is None:
-            _, _, turned_solid, turned_landmarks = read(HALF_TURN @ rotation)
+        turned_nearest = None
+        if faces_plus_y and told_kind == QUADRUPED:
+            # A quadruped's layout depends on the way it is read (its neck toward -y): read turned, it must make one
+            # too, and no known biped may lie near it.
+            turned_transform, _, turned_solid, turned_landmarks = read(HALF_TURN @ rotation)
+            turned_nearest = nearest_known_body(Mesh(apply_transform(surface.vertices, turned_transform),
+                                                     surface.triangles))
             turned_layout = _layout_of_untold_kind(turned_landmarks, None, turned_solid)
-            faces_plus_y = turned_layout is not None and turned_layout.kind == QUADRUPED
+            faces_plus_y = _of_relative_kind(turned_nearest) is None and QUADRUPED in (
+                turned_landmarks.standard_kind, turned_layout.kind if turned_layout is not None else None)
+            if not faces_plus_y:
+                # Laid out facing -y with its head end toward +Y, it makes a quadruped neither way round.
+                told = layout = None
         if faces_plus_y:
             rotation = HALF_TURN @ rotation
             transform, graph, solid, landmarks = read(rotation)
             normalised_surface = Mesh(apply_transform(surface.vertices, transform), surface.triangles)
-            nearest = nearest_known_body(normalised_surface)
+            # A quadruped's turned reading already looked for its nearest known body.
+            nearest = turned_nearest if told_kind == QUADRUPED else nearest_known_body(normalised_surface)
             relative = _of_relative_kind(nearest)
             layout = _layout_of_untold_kind(landmarks, relative, solid)
             notes.append(_turned_note(f"{cue.toward} +Y"))
