@@ -328,15 +328,18 @@ def test_a_body_read_as_other_laid_out_as_a_quadruped_gets_the_quadruped_skeleto
 TAIL = ([-0.03, 0.45, 0.45], [0.03, 0.6, 0.5])
 
 
-def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_end(monkeypatch):
+@pytest.mark.parametrize("head_at", [None, "head end"])
+def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_end(monkeypatch, head_at):
     from autorig_addon.core.rigging import predict
     from autorig_addon.core.skeleton.key_joints import key_joints
 
+    # The box animal given facing +Y. head_at None: read as given or turned, the network lays it out as a quadruped
+    # facing -y, first with its head on the tail (its head end, toward +Y, turns it), then where it is. "head end": a
+    # network that finds the head where it is, so its landmarks as given (head at +y) make no quadruped facing -y; read
+    # turned half a turn, they do.
     facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, TAIL)
-    mesh = _half_turned(facing_minus_y)
-    # Read as given (facing +Y) or turned, the network lays it out as a quadruped facing -y: first with its head on the
-    # tail (its head end, toward +Y, turns it), then where it is.
-    votes = _votes(monkeypatch, mesh, OTHER_SURELY, joints=ANIMAL_JOINTS, body=facing_minus_y)
+    votes = _votes(monkeypatch, _half_turned(facing_minus_y), OTHER_SURELY, joints=ANIMAL_JOINTS,
+                   body=facing_minus_y, head_at=head_at)
     assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
     assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
             "prediction, so its .L bones lie on its own left.") in votes.notes
@@ -345,27 +348,9 @@ def test_a_body_a_quadruped_by_its_layout_facing_plus_y_is_turned_by_its_head_en
     # In the mesh's own space the head is at +y and, facing +Y, its own left lies at -X.
     assert found["head"][1] > found["hips"][1] + 0.3
     assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0
-
-
-def test_a_quadruped_laid_out_only_read_the_other_way_round_is_turned_by_its_head_end(monkeypatch):
-    from autorig_addon.core.rigging import predict
-    from autorig_addon.core.skeleton.key_joints import key_joints
-
-    # A network that finds the head where it is: on the box animal given facing +Y, its landmarks (head at +y) make no
-    # quadruped facing -y; read turned half a turn, they do.
-    facing_minus_y = _boxes(*ANIMAL_LEGS, ANIMAL_BODY, ANIMAL_HEAD, TAIL)
-    votes = _votes(monkeypatch, _half_turned(facing_minus_y), OTHER_SURELY, joints=ANIMAL_JOINTS,
-                   body=facing_minus_y, head_at="head end")
-    assert votes.landmarks.layout is not None and votes.landmarks.layout.kind == "quadruped"
-    assert ("The character faces away from -Y (its head end is toward +Y); it was turned half a turn for the "
-            "prediction, so its .L bones lie on its own left.") in votes.notes
-    skeleton = predict.skeleton_from_votes(votes, known_rig=False)
-    found = key_joints(skeleton.names, skeleton.joints, parents=skeleton.parents).positions
-    assert found["head"][1] > found["hips"][1] + 0.3
-    assert found["shoulder.L"][0] < 0.0 and found["shoulder.R"][0] > 0.0
     # Given facing -Y, it is read as it stands: no turn.
     votes = _votes(monkeypatch, facing_minus_y, OTHER_SURELY, joints=ANIMAL_JOINTS, body=facing_minus_y,
-                   head_at="head end")
+                   head_at=head_at)
     assert votes.landmarks.layout.kind == "quadruped" and not any("turned half a turn" in n for n in votes.notes)
 
 
