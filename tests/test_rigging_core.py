@@ -748,19 +748,46 @@ def test_a_biped_facing_plus_y_is_turned_so_its_left_bones_are_on_its_left():
     assert (skeleton.tails[names["toe.L"]] - skeleton.joints[names["foot.L"]]) @ forward > 0
 
 
-def biped_with_left_arm_turned(degrees: float) -> Mesh:
-    """The procedural biped posed by its own weights with its left arm
-    turned ``degrees`` about the front-back axis at the shoulder (in its
-    frontal plane), taken as a rest shape."""
+def posed_biped(turns: dict) -> Mesh:
+    """The procedural biped posed by its own weights, each bone of ``turns``
+    turned about its axis ((3,) in the upright frame) by its degrees at its
+    head, taken as a rest shape."""
     character = generate_character(BIPED_SEED, "biped")
     deform = character.skeleton.deform_subset()
     columns = [character.weights.bone_names.index(name) for name in deform.names]
     rotations = np.tile(np.eye(3), (1, deform.bone_count, 1, 1))
-    rotations[0, deform.names.index("upper_arm.L")] = axis_angle_matrices(np.array([[0.0, 1.0, 0.0]]),
-                                                                          np.radians([degrees]))[0]
+    for bone, (axis, degrees) in turns.items():
+        rotations[0, deform.names.index(bone)] = axis_angle_matrices(np.array([axis], dtype=np.float64),
+                                                                     np.radians([degrees]))[0]
     posed = posed_vertices(character.mesh.vertices, character.weights.matrix[:, columns], character.skeleton,
                            rotations)[0]
     return Mesh(posed, character.mesh.triangles)
+
+
+def biped_with_left_arm_turned(degrees: float) -> Mesh:
+    """The procedural biped with its left arm turned ``degrees`` about the
+    front-back axis at the shoulder (in its frontal plane)."""
+    return posed_biped({"upper_arm.L": ([0.0, 1.0, 0.0], degrees)})
+
+
+@pytest.mark.parametrize("degrees", [35.0, 125.0])
+def test_a_biped_turned_on_its_turntable_in_an_uneven_stance_is_rigged_in_its_own_frame(degrees):
+    """Its left arm raised 60 degrees and its right arm 45 forward, the
+    biped's error across its own plane is 0.57 of the nearest axis plane's
+    (half or less was needed). Turned 35 degrees about Z, it was rigged in
+    the axis frame 35 degrees off its own; turned 125, with .L on its right.
+    The plane's slant, 25 degrees or more, now tells a turned character."""
+    stance = posed_biped({"upper_arm.L": ([0.0, 1.0, 0.0], 60.0), "upper_arm.R": ([0.0, 0.0, 1.0], 45.0)})
+    rotation = rotation_about([0, 0, 1], degrees)
+    votes = predict.predict_votes(Mesh(placed(stance.vertices, rotation), stance.triangles))
+    assert any(note.startswith("The character is turned ") and "degrees about Z" in note for note in votes.notes)
+    skeleton = predict.skeleton_from_votes(votes, template="biped")
+    names = {name: k for k, name in enumerate(skeleton.names)}
+    own_left = rotation @ [1.0, 0.0, 0.0]
+    for role in ("thigh", "foot"):
+        across = skeleton.joints[names[role + LEFT_SUFFIX]] - skeleton.joints[names[role + RIGHT_SUFFIX]]
+        # Within 10 degrees of its own left (its arms slant its best plane by 6).
+        assert across @ own_left > np.cos(np.radians(10.0)) * np.linalg.norm(across), role
 
 
 @pytest.mark.parametrize("degrees", [40.0, 90.0])

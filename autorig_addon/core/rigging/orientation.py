@@ -60,6 +60,18 @@ PLANE_SAMPLE_POINTS = 400
 #: that axis plane: artists' characters are modelled axis-aligned, and their
 #: best plane wanders a few degrees with a held prop or a raised arm.
 AXIS_SNAP_DEGREES = 12.0
+#: A best plane slanted at least this far (degrees) from every axis plane is
+#: a character turned on its turntable rather than one posed unevenly (a
+#: cheering dancer's raised arms slant hers by 17 degrees), and it is taken
+#: when it mirrors better than every axis plane and every plane across it by
+#: :data:`TURNED_PLANE_BETTER`, not by :data:`.symmetry.CLEARLY_BETTER`: a
+#: turned character in an uneven stance (weight on one leg, an arm forward)
+#: mirrors only a little better across its plane, and rigged in the axis
+#: frame nearest it (25 to 45 degrees off) its legs were read front to back
+#: and its facing by the wrong feet (Nexuiz's idle stances, turned 30 to 43
+#: degrees: four were kept so, one of them rigged with .L on its right).
+TURNED_PLANE_DEGREES = 25.0
+TURNED_PLANE_BETTER = 0.8
 #: The upright network must give another way of standing at least this
 #: share of its and as-it-is's probability for that way to be tried on a
 #: character that reads as a standing biped or quadruped as it is (an
@@ -208,25 +220,31 @@ def mirror_frame(points: np.ndarray) -> np.ndarray | None:
 
     The plane is :func:`best_mirror_plane`'s, snapped to an axis plane when
     within :data:`AXIS_SNAP_DEGREES`, and when farther taken only if it
-    mirrors clearly better than every axis plane: else the best axis plane.
-    On the 416 cached characters this turns 6, each one the artist's
-    skeleton shows turned the same way (the GDQuest mannequin 16 degrees,
-    five Nexuiz characters 36 to 43 degrees; three more Nexuiz characters,
-    turned as far, mirror only a little better across their plane and stay
-    as they are), and keeps a cheering dancer whose raised arms slant her
-    best plane by 17 degrees."""
+    mirrors clearly better than every axis plane (slanted by
+    :data:`TURNED_PLANE_DEGREES` or more, better by
+    :data:`TURNED_PLANE_BETTER`): else the best axis plane. On the proxies
+    of the 416 cached characters this turns 10, each within 8 degrees of the
+    way the artist's skeleton stands (the GDQuest mannequin 11 degrees, nine
+    of the eleven Nexuiz characters 30 to 43 degrees; the posed lurk and the
+    marine stay as they are), and keeps a cheering dancer whose raised arms
+    slant her best plane by 17 degrees (2026-12-08; 6 turned before
+    :data:`TURNED_PLANE_BETTER`)."""
     normal, error, across = best_mirror_plane(points)
     normal = _axis_snapped(normal)
+    clearly_better = CLEARLY_BETTER
     if np.abs(normal).max() < 1.0:
         tree = cKDTree(points)
         axis_errors = np.array([mirror_error_across(points, axis, tree) for axis in np.eye(3)])
         best_axis = int(np.argmin(axis_errors))
-        if error > CLEARLY_BETTER * axis_errors[best_axis]:
+        slant = float(np.degrees(np.arccos(min(float(np.abs(normal).max()), 1.0))))
+        if slant >= TURNED_PLANE_DEGREES and error < TURNED_PLANE_BETTER * min(float(axis_errors.min()), across):
+            clearly_better = TURNED_PLANE_BETTER  # turned on its turntable, and posed unevenly
+        elif error > CLEARLY_BETTER * axis_errors[best_axis]:
             # An axis-aligned character in an asymmetric pose (arms raised unevenly) mirrors a little better across
             # a slanted plane; one turned on its turntable mirrors far better across it.
             normal = np.eye(3)[best_axis]
             error, across = axis_errors[best_axis], float(np.delete(axis_errors, best_axis).min())
-    if error >= CLEARLY_BETTER * across:
+    if error >= clearly_better * across:
         return None
     if normal[0] < 0 or (normal[0] == 0 and (normal[1] < 0 or (normal[1] == 0 and normal[2] < 0))):
         normal = -normal  # the same plane; a fixed sign keeps an upright character's frame the identity
@@ -430,9 +448,12 @@ def _stands_on_its_head(framed: np.ndarray, triangles: np.ndarray) -> bool:
 
 def _facing_notes(frame: np.ndarray) -> list[str]:
     """What turning the mesh by ``frame`` about its vertical axis did ([] when nothing)."""
-    if np.allclose(frame, np.eye(3), atol=1e-9) or not np.allclose(frame[2], [0.0, 0.0, 1.0], atol=1e-9):
+    # Up within the snap angle of +Z is upright: a turned character's plane leans a few degrees with its stance.
+    if np.allclose(frame, np.eye(3), atol=1e-9) or frame[2, 2] < np.cos(np.radians(AXIS_SNAP_DEGREES)):
         return []
     angle = float(np.degrees(np.arctan2(frame[0, 1], frame[0, 0])))
+    if round(abs(angle)) == 0:
+        return []
     if abs(abs(angle) - 90.0) < 1e-6:
         return ["The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 of "
                 "its own space)."]
