@@ -26,6 +26,9 @@ The rule (deterministic; rerunning gives the same file):
    evaluation use them) with the reason their weights are not trusted;
    skin training and skin evaluation leave them out
    (``core.dataset.split.DataSplit.usable_for``).
+6. ``SIDES_NAMED_FROM_THE_VIEWER`` characters' bones named left lie on
+   their right (their faces tell): their references are read with the
+   sides swapped.
 
 Usage (from the repository root)::
 
@@ -149,6 +152,13 @@ SKELETON_ONLY = {
     "nexuiz/": "rigid weights (every vertex on one bone) and a rest pose that is the first idle frame (arms "
                "forward), converted from Nexuiz's .zym: not an artist's skinning",
 }
+#: Characters whose artist named the sides from the viewer, with the evidence: the bones named left lie on the
+#: character's right. Their references are read with the sides swapped (``core.dataset.normalise.facing_decision``).
+SIDES_NAMED_FROM_THE_VIEWER = {
+    "gh_godot_demo_platformer/platformer_player.glb":
+        "its face (eyes and mouth on the head's front) looks toward -Y as imported, its feet point there too, and its "
+        "l- bones (l-arm, l-thigh...) lie at -X: on its right (docs/rigging.md, Key joints)",
+}
 #: Files left out of the split, with the reason.
 _BROKEN_MIXAMO_MESH = (
     "a second mesh part (head piece or hair) stored at 100 times the body's scale lies 25 to 36 times the "
@@ -230,6 +240,8 @@ def make_split(root: str) -> dict:
         "near_duplicates": [list(group) for group in BODIES],
         "skeleton_only": skeleton_only,
         "excluded": {path: EXCLUDED[path] for path in found if path in EXCLUDED},
+        "sides_named_from_the_viewer": {path: reason for path, reason in SIDES_NAMED_FROM_THE_VIEWER.items()
+                                        if path in kinds},
         "companion_files": companions,
     }
 

@@ -211,6 +211,28 @@ def test_near_duplicates_of_the_split_name_each_other(tmp_path):
         read_data_split(tmp_path / "bad.json")
 
 
+def test_characters_whose_sides_are_named_from_the_viewer_are_flagged_for_evaluation(tmp_path):
+    flagged = {"people/val.glb": "its face looks toward -Y and its left-named bones lie at -X"}
+    (tmp_path / "split.json").write_text(json.dumps({**SPLIT, "sides_named_from_the_viewer": flagged}))
+    assert read_data_split(tmp_path / "split.json").sides_named_from_the_viewer == flagged
+    assert read_data_split_without(tmp_path, "sides_named_from_the_viewer").sides_named_from_the_viewer == {}
+    root = tmp_path / "chars"
+    for path in SPLIT["train"] + SPLIT["validation"]:
+        (root / path).parent.mkdir(parents=True, exist_ok=True)
+        (root / path).write_text("")
+    items = collect_data([str(root)], "validation", str(tmp_path / "split.json"), PURPOSE_SKELETON)
+    assert [(item.name, item.sides_named_from_the_viewer) for item in items] == [
+        ("bots/rigid_val", False), ("people/val", True)]
+    (tmp_path / "bad.json").write_text(json.dumps({**SPLIT, "sides_named_from_the_viewer": ["people/val.glb"]}))
+    with pytest.raises(InputError, match="'sides_named_from_the_viewer' must map paths to the reason their sides"):
+        read_data_split(tmp_path / "bad.json")
+
+
+def read_data_split_without(folder, key: str):
+    (folder / "without.json").write_text(json.dumps({name: value for name, value in SPLIT.items() if name != key}))
+    return read_data_split(folder / "without.json")
+
+
 def save_sample(folder, name: str) -> None:
     mesh = Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 0, 2]], float), np.array([[0, 1, 2]]))
     skeleton = Skeleton(np.array([[0, 0, 0], [0, 0, 1]], float), [-1, 0], ("hips", "head"))
@@ -300,6 +322,7 @@ def test_split_script_on_a_generated_tree(tmp_path):
     assert list(first["excluded"]) == ["gh_quaternius_via_imagine_dungeons/cleric.glb"]
     assert "gh_quaternius_via_imagine_dungeons/cleric.glb" not in side
     assert first["skeleton_only"] == {"nexuiz/nexuiz_x.glb": script.SKELETON_ONLY["nexuiz/"]}
+    assert first["sides_named_from_the_viewer"] == {}  # the generated tree holds none of the listed files
     # The first split's sides stay, though Cow and Bull share a rig.
     assert (side["quaternius_glb/animals_pack/Cow.glb"], side["quaternius_glb/animals_pack/Bull.glb"]) == (
         VALIDATION, TRAIN)
@@ -341,6 +364,7 @@ def test_committed_split_is_disjoint_and_every_kind_is_on_both_sides(committed_s
     every = {path for paths in committed_split["categories"].values() for path in paths}
     assert train | validation == every
     assert not every & set(committed_split["excluded"]) and set(committed_split["skeleton_only"]) <= every
+    assert set(committed_split["sides_named_from_the_viewer"]) <= every
     assert 0.2 <= len(validation) / len(every) <= 0.35
     for kind, paths in committed_split["categories"].items():
         assert validation & set(paths) and set(paths) - validation, kind

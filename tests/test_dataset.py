@@ -151,6 +151,22 @@ def test_the_head_ahead_of_the_tail_outranks_mirrored_side_names():
     assert facing_decision(quadruped(left_x=0.3)).note == "faces -Y as loaded (side names: left joints at +X)"
 
 
+def test_sides_named_from_the_viewer_turn_the_character_the_other_way():
+    # Godot's platformer robot faces -Y with its l- bones at -X: told so, it is kept facing -Y.
+    from_the_viewer = quadruped(left_x=-0.3)
+    plain = Skeleton(from_the_viewer.joints, from_the_viewer.parents,
+                     ("spine", "neck", "back") + from_the_viewer.names[3:], deform=from_the_viewer.deform)
+    assert facing_decision(plain).quarter_turns == 2
+    decision = facing_decision(plain, sides_named_from_the_viewer=True)
+    assert (decision.quarter_turns, decision.facing) == (0, FACING_AS_NAMED)
+    assert decision.note == "faces -Y as loaded (side names, given from the viewer: right joints at +X)"
+    # Facing +X so named, it turns a quarter the other way: clockwise, its face to -Y.
+    assert facing_decision(turned_about_z(plain, 90.0), sides_named_from_the_viewer=True).quarter_turns == 3
+    mesh = Mesh(np.array([[-0.4, -1.0, 0.0], [0.4, -1.0, 0.0], [0.0, 1.0, 1.3]]), np.array([[0, 1, 2]]))
+    normalised = normalise(mesh, plain, sides_named_from_the_viewer=True)
+    np.testing.assert_allclose(normalised.transform[:3, 0], [1.0 / 2.0, 0.0, 0.0])  # kept: only scaled by 1/2
+
+
 def test_the_head_ahead_of_the_tail_turns_an_animal_without_side_names():
     plain = quadruped(left_x=0.3)
     anonymous = Skeleton(plain.joints, plain.parents, ("spine", "head", "tail") + tuple(f"leg{k}" for k in range(8)))
@@ -280,15 +296,16 @@ def test_loading_another_format_version_is_an_input_error(tmp_path):
 class CountingLoader:
     """Stands in for the Blender loader: returns the biped, counts calls."""
 
-    def __init__(self):
+    def __init__(self, sides_named_from_the_viewer: bool = False):
         self.calls = []
+        self.sides_named_from_the_viewer = sides_named_from_the_viewer
 
     def __call__(self, path, target_vertices):
         self.calls.append((path.name, target_vertices))
         sample, mesh, weights = make_sample(name=path.stem)
         _, skeleton = biped(facing_plus_y=True)
         return SimpleNamespace(name=path.stem, category="biped", mesh=mesh, skeleton=skeleton, weights=weights,
-                               notes=NOTES)
+                               notes=NOTES, sides_named_from_the_viewer=self.sides_named_from_the_viewer)
 
 
 def character_files(tmp_path, count=2):
@@ -321,6 +338,19 @@ def test_build_samples_caches_and_reuses(tmp_path):
     paths[0].write_bytes(b"edited")
     build_samples(paths, loader, tmp_path / "cache", target_vertices=2000)
     assert [call[0] for call in loader.calls[4:]] == ["char0.glb"]
+
+
+def test_a_character_named_from_the_viewer_gets_a_sample_of_its_own_turned_the_other_way(tmp_path):
+    # The loader's biped faces +Y by its side names; told they were named from the viewer, it faces -Y as given.
+    paths = character_files(tmp_path)
+    plain = build_samples(paths, CountingLoader(), tmp_path / "cache")
+    told_loader = CountingLoader(sides_named_from_the_viewer=True)
+    told = build_samples(paths, told_loader, tmp_path / "cache", key_extras=lambda path: (
+        {"sides_named_from_the_viewer": True} if path.name == "char1.glb" else {}))
+    assert [call[0] for call in told_loader.calls] == ["char1.glb"]  # char0's cached sample still serves
+    assert plain[1].facing == FACING_TURNED and told[1].facing == FACING_AS_NAMED
+    np.testing.assert_allclose(told[1].vertices[:, :2], -plain[1].vertices[:, :2], atol=1e-12)
+    assert len(list((tmp_path / "cache").glob("char1-*.npz"))) == 2
 
 
 def test_builds_are_reproducible(tmp_path):

@@ -130,3 +130,15 @@ def test_score_key_joints_uses_the_characters_size_and_skips_rigs_without_limbs(
     # A fish's Head alone says no limb: not scored.
     fish = Skeleton(np.array([[0.0, 0.0, 1.0]]), np.array([-1]), ("Head",))
     assert score_key_joints(fish, mesh, fish, size=2.0) == {}
+
+
+def test_a_reference_named_from_the_viewer_is_scored_by_the_characters_own_sides():
+    # The artist's thigh.L lies at -X on a character facing -Y: its own right. A prediction with thigh.L at +X
+    # (its own left) is right once the split says the sides were named from the viewer.
+    mesh = box_mesh([-0.5, -0.25, 0.0], [0.5, 0.25, 2.0], 0.25)
+    names = ("hips", "thigh.L", "thigh.R")
+    reference = Skeleton(np.array([[0.0, 0.0, 1.0], [-0.2, 0.0, 0.9], [0.2, 0.0, 0.9]]), np.array([-1, 0, 0]), names)
+    predicted = Skeleton(np.array([[0.0, 0.0, 1.0], [0.2, 0.0, 0.9], [-0.2, 0.0, 0.9]]), np.array([-1, 0, 0]), names)
+    assert score_key_joints(predicted, mesh, reference, size=2.0)["key_joints"] == pytest.approx(1.0 / 3.0)
+    told = score_key_joints(predicted, mesh, reference, size=2.0, sides_named_from_the_viewer=True)
+    assert told["key_joints"] == 1.0 and told["key_joint_errors"]["hip.L"] == pytest.approx(0.0)

@@ -70,6 +70,9 @@ class RiggedCharacter:
         from the joints, ...).
     source_vertex_count : int
         Vertices of the mesh as loaded, before any simplification.
+    sides_named_from_the_viewer : bool
+        ``data_split.json`` says its artist named the sides from the viewer
+        (set by :func:`build_character_samples`; its sample is normalised so).
     """
 
     name: str
@@ -81,6 +84,7 @@ class RiggedCharacter:
     armature_name: str = ""
     notes: tuple = ()
     source_vertex_count: int = 0
+    sides_named_from_the_viewer: bool = False
 
     @property
     def unweighted(self) -> np.ndarray:
@@ -273,8 +277,17 @@ def build_character_samples(
     list of core.dataset.CharacterSample
     """
 
+    def named_from_the_viewer(path: Path) -> bool:
+        listed = split.sides_named_from_the_viewer if split is not None else {}
+        return dataset.relative_name(path, root) + path.suffix in listed
+
     def load(path: Path, target: Optional[int]):
         name = dataset.relative_name(path, root)
-        return load_simplified(path, target, name, dataset.category_of(name + path.suffix, split))
+        character = load_simplified(path, target, name, dataset.category_of(name + path.suffix, split))
+        return replace(character, sides_named_from_the_viewer=named_from_the_viewer(path))
 
-    return dataset.build_samples(paths, load, cache_dir, target_vertices, progress)
+    def key_extras(path: Path) -> dict:
+        # Only a flagged character's key changes: every other cached sample stays valid.
+        return {"sides_named_from_the_viewer": True} if named_from_the_viewer(path) else {}
+
+    return dataset.build_samples(paths, load, cache_dir, target_vertices, progress, key_extras)

@@ -152,7 +152,8 @@ def evaluate_rig_item(item: DataItem, method: str) -> dict:
     # RigNet's unit: the largest side of the bounding box, not the diagonal the skin metrics use.
     size = largest_side(character.mesh.vertices)
     scores = evaluate_rig(predicted.skeleton, character.skeleton, size)
-    scores.update(score_key_joints(predicted.skeleton, character.mesh, character.skeleton, size))
+    scores.update(score_key_joints(predicted.skeleton, character.mesh, character.skeleton, size,
+                                   item.sides_named_from_the_viewer))
     return {**scores, "seconds": seconds, "notes": list(character.notes) + list(predicted.notes)}
 
 

@@ -107,8 +107,9 @@ def sample_path(cache_dir: str | os.PathLike, source: str | os.PathLike, key: st
 
 #: ``load(path, target_vertices)`` returns an object with ``name``,
 #: ``category``, ``mesh`` (Mesh), ``skeleton`` (Skeleton), ``weights``
-#: (Weights over the deform bones) and optionally ``source_vertex_count``
-#: and ``notes`` (tuple of str), as ``blender.characters.RiggedCharacter``.
+#: (Weights over the deform bones) and optionally ``source_vertex_count``,
+#: ``notes`` (tuple of str) and ``sides_named_from_the_viewer`` (bool), as
+#: ``blender.characters.RiggedCharacter``.
 CharacterLoader = Callable[[Path, Optional[int]], object]
 
 
@@ -118,6 +119,7 @@ def build_samples(
     cache_dir: str | os.PathLike | None = None,
     target_vertices: Optional[int] = DEFAULT_TARGET_VERTICES,
     progress: Optional[ProgressCallback] = None,
+    key_extras: Optional[Callable[[Path], dict]] = None,
 ) -> list[CharacterSample]:
     """Samples of rigged character files, built once and then read from the cache.
 
@@ -133,6 +135,9 @@ def build_samples(
         Vertex count the mesh is simplified to (:data:`RECOMMENDED_VERTEX_RANGE`
         suits networks); None keeps the full mesh.
     progress : ProgressCallback, optional
+    key_extras : callable(path) -> dict, optional
+        What else the loader does to a file that its sample's cache key must
+        hold (``sides_named_from_the_viewer``); {} for most files.
 
     Returns
     -------
@@ -149,7 +154,8 @@ def build_samples(
     samples = []
     for index, path in enumerate(paths):
         report(progress, index / max(len(paths), 1), f"Sample of {path.name}")
-        cached = sample_path(cache, path, sample_cache_key(path, parameters))
+        key_parameters = {**parameters, **(key_extras(path) if key_extras is not None else {})}
+        cached = sample_path(cache, path, sample_cache_key(path, key_parameters))
         if cached.is_file():
             samples.append(CharacterSample.load(cached))
             continue
@@ -157,6 +163,7 @@ def build_samples(
         sample = CharacterSample.from_character(
             character.name, character.category, character.mesh, character.skeleton, character.weights,
             getattr(character, "source_vertex_count", 0), getattr(character, "notes", ()),
+            getattr(character, "sides_named_from_the_viewer", False),
         )
         sample.save(cached)
         samples.append(sample)

@@ -187,8 +187,12 @@ def _degrees_off_axis(direction: np.ndarray) -> float:
 _TURN_WORDS = {1: "a quarter turn counter-clockwise", 2: "half a turn", 3: "a quarter turn clockwise"}
 
 
-def facing_decision(skeleton: Skeleton) -> FacingDecision:
+def facing_decision(skeleton: Skeleton, sides_named_from_the_viewer: bool = False) -> FacingDecision:
     """The quarter turns that make a character face -Y, and why (see the module docstring).
+
+    ``sides_named_from_the_viewer``: its artist named the sides from the
+    viewer (``data_split.json`` says so, its face the evidence), so its
+    side names put its own left where they say right.
 
     Notes read ``"faces -Y as loaded (side names: left joints at +X)"``,
     ``"turned half a turn to face -Y (head ahead of tail; its side names would
@@ -196,11 +200,14 @@ def facing_decision(skeleton: Skeleton) -> FacingDecision:
     ``"facing kept as loaded: no side names, no head ahead of a tail"``.
     """
     named, head_tail = facing_quarter_turns(skeleton), head_tail_quarter_turns(skeleton)
+    if named is not None and sides_named_from_the_viewer:
+        named = (named + 2) % 4
     if head_tail is not None and named is not None and head_tail != named:
         turns, cue = head_tail, (f"head ahead of tail; its side names would have turned it "
                                  f"{_TURN_WORDS.get(named, 'not at all')}, so they are mirrored or not lateral")
     elif named is not None:
-        turns, cue = named, "side names: left joints at +X"
+        turns, cue = named, ("side names, given from the viewer: right joints at +X" if sides_named_from_the_viewer
+                             else "side names: left joints at +X")
         off_axis = _degrees_off_axis(named_left_direction(skeleton))
         if off_axis > OFF_AXIS_NOTE_DEGREES:
             cue += f"; the left-right line is {off_axis:.0f} degrees off that axis"
@@ -276,7 +283,7 @@ def apply_transform(points: np.ndarray, transform: np.ndarray) -> np.ndarray:
     return points @ transform[:3, :3].T + transform[:3, 3]
 
 
-def normalise(mesh: Mesh, skeleton: Skeleton) -> Normalised:
+def normalise(mesh: Mesh, skeleton: Skeleton, sides_named_from_the_viewer: bool = False) -> Normalised:
     """Move a character into the common frame (see the module docstring).
 
     Parameters
@@ -284,6 +291,9 @@ def normalise(mesh: Mesh, skeleton: Skeleton) -> Normalised:
     mesh : Mesh
     skeleton : Skeleton
         In the mesh's space.
+    sides_named_from_the_viewer : bool
+        Its side names put its own left where they say right
+        (:func:`facing_decision`).
 
     Returns
     -------
@@ -292,7 +302,7 @@ def normalise(mesh: Mesh, skeleton: Skeleton) -> Normalised:
         deform flags are unchanged (a rotation and a positive scale keep the
         triangles' orientation).
     """
-    decision = facing_decision(skeleton)
+    decision = facing_decision(skeleton, sides_named_from_the_viewer)
     transform = normalisation_transform(mesh.vertices, decision.quarter_turns)
     moved_mesh = Mesh(
         apply_transform(mesh.vertices, transform), mesh.triangles, mesh.triangle_polygons,

@@ -96,7 +96,7 @@ class CharacterSample:
     @classmethod
     def from_character(
         cls, name: str, category: str, mesh: Mesh, skeleton: Skeleton, weights: Weights, source_vertex_count: int = 0,
-        notes: tuple = (),
+        notes: tuple = (), sides_named_from_the_viewer: bool = False,
     ) -> "CharacterSample":
         """Normalise a character and keep its deform-bone weights.
 
@@ -109,12 +109,14 @@ class CharacterSample:
         source_vertex_count : int, vertices before any simplification
         notes : tuple of str, the loader's notes, kept as they are; the
             normalisation's own (:attr:`.normalise.Normalised.notes`) follow
+        sides_named_from_the_viewer : bool, its artist named the sides from
+            the viewer (:func:`.normalise.facing_decision`)
         """
         if weights.vertex_count != mesh.vertex_count:
             raise InputError(
                 f"'{name}': the weights have {weights.vertex_count} rows but the mesh has {mesh.vertex_count} vertices."
             )
-        normalised = normalise(mesh, skeleton)
+        normalised = normalise(mesh, skeleton, sides_named_from_the_viewer)
         deform_names = skeleton.deform_subset().names
         matrix = normalize_rows(weights.select_bones(deform_names).matrix)
         return cls(

@@ -57,6 +57,11 @@ class DataSplit:
     near_duplicates : tuple of frozenset of str
         Groups of paths whose characters are near-duplicates of one another
         (the same body and rig in other clothes or colours).
+    sides_named_from_the_viewer : dict of str -> str
+        Paths whose artist named the bones' sides from the viewer (``l-arm``
+        on the character's right, its face telling which way it looks), with
+        the evidence: their references are read with the sides swapped
+        (:func:`~.normalise.normalise`).
     """
 
     train: tuple
@@ -66,6 +71,7 @@ class DataSplit:
     excluded: dict = field(default_factory=dict)
     families: dict = field(default_factory=dict)
     near_duplicates: tuple = ()
+    sides_named_from_the_viewer: dict = field(default_factory=dict)
 
     def near_duplicate_names(self, name: str) -> frozenset:
         """``name`` (a path without extension) and the names of its near-duplicates."""
@@ -100,7 +106,8 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
     """Read ``data_split.json``.
 
     Accepts ``categories`` as ``{path: category}`` or ``{category: [paths]}``;
-    ``skeleton_only`` and ``excluded`` (``{path: reason}``) are optional.
+    ``skeleton_only``, ``excluded`` and ``sides_named_from_the_viewer``
+    (``{path: reason}``) are optional.
 
     Raises
     ------
@@ -118,7 +125,8 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
     train = tuple(_split_path(entry) for entry in document["train"])
     validation = tuple(_split_path(entry) for entry in document["validation"])
     reasons = {}
-    for key, meaning in (("skeleton_only", "their weights are not used"), ("excluded", "they are left out")):
+    for key, meaning in (("skeleton_only", "their weights are not used"), ("excluded", "they are left out"),
+                         ("sides_named_from_the_viewer", "their sides are named from the viewer")):
         value = document.get(key, {})
         if not isinstance(value, dict):
             raise InputError(f"'{path.name}': '{key}' must map paths to the reason {meaning}.")
@@ -128,7 +136,8 @@ def read_data_split(path: str | os.PathLike) -> DataSplit:
         raise InputError(f"'{path.name}': 'near_duplicates' must be a list of lists of paths.")
     return DataSplit(train, validation, _categories(document.get("categories", {})), reasons["skeleton_only"],
                      reasons["excluded"], _families(document.get("families", []), path.name),
-                     tuple(frozenset(_split_path(entry) for entry in group) for group in near_duplicates))
+                     tuple(frozenset(_split_path(entry) for entry in group) for group in near_duplicates),
+                     reasons["sides_named_from_the_viewer"])
 
 
 def _split_path(entry) -> str:
@@ -186,11 +195,13 @@ def select_split(relative_paths: Sequence[str], split: DataSplit, subset: str) -
 
 @dataclass(frozen=True)
 class DataItem:
-    """One file to evaluate: its path, name and category."""
+    """One file to evaluate: its path, name and category, and whether the
+    split says its artist named the sides from the viewer."""
 
     path: Path
     name: str
     category: str
+    sides_named_from_the_viewer: bool = False
 
 
 def collect_data(inputs: list[str], split_name: str = "all", split_file: Optional[str] = None,
@@ -259,7 +270,8 @@ def collect_data(inputs: list[str], split_name: str = "all", split_file: Optiona
                     skipped(name, split.skeleton_only[entry])
                 continue
             category = category_of(entry, split) if entry is not None else path.parent.name
-            items.append(DataItem(path, name, category or "uncategorised"))
+            from_the_viewer = entry is not None and entry in split.sides_named_from_the_viewer
+            items.append(DataItem(path, name, category or "uncategorised", from_the_viewer))
     if not items:
         where = ", ".join(inputs)
         if split_name != "all":

@@ -47,15 +47,17 @@ def key_joint_score(predicted: KeyJoints, reference: KeyJoints, tolerance: float
             "key_joint_count": len(roles), "key_joint_errors": errors}
 
 
-def score_key_joints(predicted: Skeleton, mesh: Mesh, reference: Skeleton, size: float) -> dict:
+def score_key_joints(predicted: Skeleton, mesh: Mesh, reference: Skeleton, size: float,
+                     sides_named_from_the_viewer: bool = False) -> dict:
     """The key-joint scores of a predicted skeleton (:func:`key_joint_score`),
     with tolerance :data:`KEY_JOINT_FRACTION` of ``size``; empty when the
     reference's bone names say no limb (a fish's ``Head`` alone is not scored).
 
     The reference's sides are the character's own: its left is +X of the
-    normalised frame (:func:`~..dataset.normalise.normalise`).
+    normalised frame (:func:`~..dataset.normalise.normalise`, told when
+    its artist named the sides from the viewer).
     """
-    left = np.linalg.inv(normalise(mesh, reference).transform)[:3, 0]
+    left = np.linalg.inv(normalise(mesh, reference, sides_named_from_the_viewer).transform)[:3, 0]
     truth = key_joints(reference.names, reference.joints, left_direction=left, parents=reference.parents)
     if not any(role.endswith((LEFT, RIGHT)) for role in truth.positions):
         return {}
