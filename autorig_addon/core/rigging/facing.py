@@ -155,23 +155,34 @@ class Facing:
     reason : str, what told it, for the report ("its toes point toward +Y", "its toes point that way")
     front_untold : bool, nothing told its front: read neither way as a biped or quadruped, it is taken
         to face -y as it was given (:func:`front_untold_note`)
+    untold_kind : str or None, the kind it is read as (one way round or both) when neither its shape cue
+        (:func:`front_cue`) nor the network's surer reading told its front: taken to face -y as it was
+        given, which the report must say (a biped with stub feet given facing +Y is rigged back to front)
     """
 
     turn: bool
     read_from_behind: bool = False
     reason: str = ""
     front_untold: bool = False
+    untold_kind: str | None = None
 
 
-def front_untold_note(front: str, told_kind: str | None = None) -> str:
+def front_untold_note(front: str, told_kind: str | None = None, read_as: str | None = None) -> str:
     """The report's note when nothing tells which way a body faces
     (``front``: the mesh-space axis it was taken to face, '-Y', '+X'...);
     ``told_kind``: the kind a body's nearest known body or its layout makes
     it (biped, quadruped), whose shape cue (:func:`front_cue`) does not
-    tell either. Its shape alone does not: a linear score of the
+    tell either; ``read_as``: the kind the landmark network reads it as,
+    about as surely either way round, whose shape cue does not tell
+    (:attr:`Facing.untold_kind`). Its shape alone does not: a linear score of the
     front-to-back profile (area, height, width and spread per band) told the
     front of 14 of the 23 validation fish, flyers and monsters
     (``scripts/check_front_profile.py``; docs/rigging.md, *Orientation*)."""
+    if read_as is not None:
+        cue = "its toes do not tell" if read_as == BIPED else "neither end of it stands higher"
+        return (f"Which way the character faces could not be told (the landmark network reads it as a {read_as} about "
+                f"as surely either way round, and {cue}): it was taken to face {front} of its own space, so its .L "
+                "bones lie on its left seen so. If it faces another way, turn it to face -Y and predict again.")
     if told_kind is not None:
         cue = "its toes do not tell" if told_kind == BIPED else "neither end of it stands higher"
         return (f"Which way the character faces could not be told (the landmark network reads it as neither a biped "
@@ -241,7 +252,8 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"
         return Facing(True, reason=f"turned, it reads more surely as {kind}")
-    return Facing(False, front_untold=kinds == (OTHER, OTHER))
+    surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
+    return Facing(False, front_untold=kinds == (OTHER, OTHER), untold_kind=None if surer_as_given else shape_kind)
 
 
 def _keeps_the_head_end(reading: Landmarks, shape_kind: str) -> bool:

@@ -251,6 +251,8 @@ def predict_votes(mesh: Mesh, progress: ProgressCallback | None = None) -> Joint
         rotation = HALF_TURN @ rotation
         transform, graph, solid, landmarks = read(rotation)
         notes.append(_turned_note(way.reason))
+    if way.untold_kind is not None:
+        notes.append(front_untold_note(axis_name(-rotation[1]), read_as=way.untold_kind))
     if way.read_from_behind:
         landmarks = from_behind(turned)
         facing_note = "Turned, it" if way.turn else f"The character faces -Y ({way.reason}) but"
