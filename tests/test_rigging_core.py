@@ -822,6 +822,9 @@ def biped_with_left_arm_turned(degrees: float) -> Mesh:
     return posed_biped({"upper_arm.L": ([0.0, 1.0, 0.0], degrees)})
 
 
+UNEVEN_STANCE = {"upper_arm.L": ([0.0, 1.0, 0.0], 60.0), "upper_arm.R": ([0.0, 0.0, 1.0], 45.0)}
+
+
 @pytest.mark.parametrize("degrees", [35.0, 125.0])
 def test_a_biped_turned_on_its_turntable_in_an_uneven_stance_is_rigged_in_its_own_frame(degrees):
     """Its left arm raised 60 degrees and its right arm 45 forward, the
@@ -829,7 +832,7 @@ def test_a_biped_turned_on_its_turntable_in_an_uneven_stance_is_rigged_in_its_ow
     (half or less was needed). Turned 35 degrees about Z, it was rigged in
     the axis frame 35 degrees off its own; turned 125, with .L on its right.
     The plane's slant, 25 degrees or more, now tells a turned character."""
-    stance = posed_biped({"upper_arm.L": ([0.0, 1.0, 0.0], 60.0), "upper_arm.R": ([0.0, 0.0, 1.0], 45.0)})
+    stance = posed_biped(UNEVEN_STANCE)
     rotation = rotation_about([0, 0, 1], degrees)
     votes = predict.predict_votes(Mesh(placed(stance.vertices, rotation), stance.triangles))
     assert any(note.startswith("The character is turned ") and "degrees about Z" in note for note in votes.notes)
@@ -840,6 +843,21 @@ def test_a_biped_turned_on_its_turntable_in_an_uneven_stance_is_rigged_in_its_ow
         across = skeleton.joints[names[role + LEFT_SUFFIX]] - skeleton.joints[names[role + RIGHT_SUFFIX]]
         # Within 10 degrees of its own left (its arms slant its best plane by 6).
         assert across @ own_left > np.cos(np.radians(10.0)) * np.linalg.norm(across), role
+
+
+def test_a_turned_biped_at_ease_lying_on_its_back_is_stood_up():
+    """The biped at ease (its left thigh out 15 degrees, that knee bent 40,
+    the foot back: its error across its own plane half the nearest axis
+    plane's or more), turned
+    35 degrees about its up, then laid on its back (a Y-up import): its
+    slanted plane holds its up (+Y) wholly and +Z only partly. Taking +Z
+    for up (the first axis lying mostly in the plane), it was stood up the
+    wrong way; the axis lying most in the plane is its up."""
+    stance = posed_biped({"thigh.L": ([0.0, 1.0, 0.0], 15.0), "shin.L": ([1.0, 0.0, 0.0], -40.0)})
+    rotation = rotation_about([1, 0, 0], -90) @ rotation_about([0, 0, 1], 35)
+    mesh = Mesh(placed(stance.vertices, rotation), stance.triangles)
+    skeleton = predict.skeleton_from_votes(predict.predict_votes(mesh), template="biped")
+    assert_standing_in_its_own_frame(skeleton, rotation, "head", "spine", ("thigh", "foot"))
 
 
 @pytest.mark.parametrize("degrees", [40.0, 90.0])

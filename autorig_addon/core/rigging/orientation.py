@@ -72,6 +72,10 @@ AXIS_SNAP_DEGREES = 12.0
 #: degrees: four were kept so, one of them rigged with .L on its right).
 TURNED_PLANE_DEGREES = 25.0
 TURNED_PLANE_BETTER = 0.8
+#: The mirror frame's up is the mesh axis lying most in the plane; +Z, then
+#: +Y, is preferred when its share along the plane's normal is within this
+#: of the least (an upright character's plane leans a few degrees).
+UP_AXIS_TIE = 0.05
 #: A body whose spread in its mirror plane (area-weighted variance) is at
 #: least this many times larger along its major axis than across is tall
 #: and thin; leaning :data:`LEANING_DEGREES` or more (and under 45) from the
@@ -261,12 +265,12 @@ def mirror_frame(points: np.ndarray) -> np.ndarray | None:
         return None
     if normal[0] < 0 or (normal[0] == 0 and (normal[1] < 0 or (normal[1] == 0 and normal[2] < 0))):
         normal = -normal  # the same plane; a fixed sign keeps an upright character's frame the identity
-    up = None
-    for axis in (2, 1, 0):  # +Z, then +Y, then +X: the first that lies mostly in the plane
-        candidate = np.eye(3)[axis] - normal[axis] * normal
-        if np.linalg.norm(candidate) >= np.cos(np.radians(45.0)):
-            up = candidate / np.linalg.norm(candidate)
-            break
+    # The axis lying most in the plane (least along its normal), +Z, then +Y, then +X when nearly as much: a
+    # turned character lying on its back has its plane slanted about its up (+Y), and +Z lies only partly in it.
+    least = float(np.abs(normal).min())
+    axis = next(axis for axis in (2, 1, 0) if abs(normal[axis]) <= least + UP_AXIS_TIE)
+    up = np.eye(3)[axis] - normal[axis] * normal
+    up /= np.linalg.norm(up)
     return np.stack([normal, np.cross(up, normal), up])
 
 
