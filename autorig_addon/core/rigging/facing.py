@@ -21,6 +21,11 @@ character's facing (every third, as loaded and turned: the same 216
 readings without it), and on validation characters it turned `Zombie_Male`
 and the cyberpunk `Character` half a turn whichever way they were given.
 
+A biped or quadruped whose shape cue does not tell, read about as surely
+either way round, is taken to face -y as it was given, and the report says
+so (:attr:`Facing.untold_kind`; Quaternius' animated pack, trouser legs to
+the ground, given facing +Y is rigged back to front).
+
 A body kept facing -y by its shape that the network reads far more surely
 from behind (one unlike its training characters: the network saw its back
 as a front) takes that reading, turned back with its sides swapped
@@ -237,6 +242,7 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     """
     kinds = (landmarks.kind, turned.kind)
     surer_turned = standard_confidence(turned) >= standard_confidence(landmarks) + TURNED_CONFIDENCE_GAIN
+    surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
     shape_kind = BIPED if BIPED in kinds else QUADRUPED if QUADRUPED in kinds else None
     cue = front_cue(surface, shape_kind) if shape_kind is not None else None
     shape = (cue.reach < 0.0, cue.toward, cue.that_way) if cue is not None and cue.tells else None
@@ -244,7 +250,6 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
         backward, toward, that_way = shape
         if backward:
             # Turned to face -y, it is seen from behind as it was given: that reading, if far surer, is the one kept.
-            surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
             return Facing(True, surer_as_given and _keeps_the_head_end(from_behind(landmarks), shape_kind),
                           f"{toward} +Y")
         behind = surer_turned and _keeps_the_head_end(from_behind(turned), shape_kind)
@@ -252,7 +257,6 @@ def facing(landmarks: Landmarks, turned: Landmarks, surface: Mesh) -> Facing:
     if surer_turned:
         kind = f"a {turned.kind}" if turned.kind != OTHER else "a biped or quadruped"
         return Facing(True, reason=f"turned, it reads more surely as {kind}")
-    surer_as_given = standard_confidence(landmarks) >= standard_confidence(turned) + TURNED_CONFIDENCE_GAIN
     return Facing(False, front_untold=kinds == (OTHER, OTHER), untold_kind=None if surer_as_given else shape_kind)
 
 

@@ -11,8 +11,10 @@ is on the character's own left. Which of the two ways along the found axis
 the character faces (-Y or +Y) is :mod:`.facing`'s call, after this.
 
 Up is chosen among the six axis directions of the mesh's own space (a
-character is modelled upright along one of them), and the facing among
-every direction about up:
+character is modelled upright along one of them), or along the length of a
+tall, thin body that leans 20 to 45 degrees from the nearest
+(:func:`_stood_along_its_length`), and the facing among every direction
+about up:
 
 1. **The mirror plane.** A character is left-right symmetric: the plane
    through its centre that mirrors it best (:func:`best_mirror_plane`:
