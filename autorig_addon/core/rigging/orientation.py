@@ -503,8 +503,10 @@ def _facing_notes(frame: np.ndarray) -> list[str]:
     if abs(abs(angle) - 90.0) < 1e-6:
         return ["The character faces +-X; it was turned a quarter for the prediction (its mirror plane is x = 0 of "
                 "its own space)."]
-    return [f"The character is turned {abs(angle):.0f} degrees about Z from facing -Y or +Y (its mirror plane "
-            "was found at that angle); it was turned back for the prediction."]
+    # Said from the nearer pair of axes: a plane 63 degrees off x is a character 27 degrees off facing +-X.
+    nearer, off = ("-Y or +Y", abs(angle)) if abs(angle) <= 45.0 else ("+X or -X", 90.0 - abs(angle))
+    return [f"The character is turned {off:.0f} degrees about Z from facing {nearer} (its mirror plane was found at "
+            "that angle); it was turned back for the prediction."]
 
 
 def _turn_note(rotation: np.ndarray, how: str, landmarks) -> str:
