@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..skeleton.naming import LEFT_SUFFIX, RIGHT_SUFFIX
 from .joint_features import SolidDepth
 from .networks.landmarks import BODY_KINDS
 
@@ -50,7 +51,7 @@ BIPED, QUADRUPED = BODY_KINDS[:2]
 
 #: Each side's two arm bones and two leg bones (a quadruped's front and hind legs).
 LIMB_SEGMENTS = tuple(
-    (start + side, end + side) for side in (".L", ".R")
+    (start + side, end + side) for side in (LEFT_SUFFIX, RIGHT_SUFFIX)
     for start, end in (("shoulder", "elbow"), ("elbow", "wrist"), ("hip", "knee"), ("knee", "ankle"))
 )
 #: The trunk, from the hips to the neck.
@@ -161,7 +162,7 @@ def quadruped_layout(points: dict, solid: SolidDepth) -> BodyLayout | None:
       times as much as it rises or falls (the neck at the front).
     """
     points = {name: np.asarray(point, dtype=np.float64) for name, point in points.items()}
-    for side in (".L", ".R"):
+    for side in (LEFT_SUFFIX, RIGHT_SUFFIX):
         if not (points["shoulder" + side][2] > points["elbow" + side][2] > points["wrist" + side][2]
                 and points["hip" + side][2] > points["knee" + side][2] > points["ankle" + side][2]):
             return None
